@@ -1,0 +1,104 @@
+/* Broad phase: candidate body pairs from swept bounding boxes. Brute force for a few bodies,
+ * sort-and-sweep along x above broadphase_threshold (AUTO). */
+#include <math.h>
+#include <stdlib.h>
+#include "world.h"
+
+typedef struct box { double x0, y0, x1, y1; int row; } box;
+
+static void body_box(const lc_world *w, const double *s, int row, box *b)
+{
+    const lc_shape *sh = &w->shape[row];
+    const double *st = &s[row * 6];
+    double c = cos(st[SA]), sn = sin(st[SA]);
+    int i;
+    b->x0 = b->y0 = INFINITY;
+    b->x1 = b->y1 = -INFINITY;
+    for (i = 0; i < sh->count; ++i) {
+        lc_vec2 p = lc_rot(c, sn, sh->v[i]);
+        double x = st[SX] + p.x, y = st[SY] + p.y;
+        if (x < b->x0) b->x0 = x;
+        if (x > b->x1) b->x1 = x;
+        if (y < b->y0) b->y0 = y;
+        if (y > b->y1) b->y1 = y;
+    }
+    b->row = row;
+}
+
+static int overlap(const box *a, const box *b)
+{
+    return a->x0 <= b->x1 && b->x0 <= a->x1 && a->y0 <= b->y1 && b->y0 <= a->y1;
+}
+
+static int add_pair(lc_buf *buf, int count, int a, int b)
+{
+    int *p = lc_buf_get(buf, (size_t)(count + 1) * 2 * sizeof(int));
+    if (p == NULL) return -1;
+    if (a > b) { int t = a; a = b; b = t; }
+    p[2 * count] = a;
+    p[2 * count + 1] = b;
+    return count + 1;
+}
+
+static int cmp_box(const void *x, const void *y)
+{
+    const box *a = x, *b = y;
+    if (a->x0 < b->x0) return -1;
+    if (a->x0 > b->x0) return 1;
+    return a->row - b->row;   /* ties broken by row: deterministic */
+}
+
+static int cmp_pair(const void *x, const void *y)
+{
+    const int *a = x, *b = y;
+    if (a[0] != b[0]) return a[0] - b[0];
+    return a[1] - b[1];
+}
+
+int lc_broad_phase(lc_world *w, const double *s0, const double *s1, double margin, lc_buf *buf)
+{
+    int n = w->count, i, j, count = 0;
+    box *boxes = lc_buf_get(&w->b_aabb, (size_t)(n > 0 ? n : 1) * sizeof(box));
+    int use_sweep;
+    if (boxes == NULL) return -1;
+    for (i = 0; i < n; ++i) {
+        box b0, b1;
+        body_box(w, s0, i, &b0);
+        if (s1 != s0 && !w->is_static[i]) {
+            body_box(w, s1, i, &b1);
+            if (b1.x0 < b0.x0) b0.x0 = b1.x0;
+            if (b1.y0 < b0.y0) b0.y0 = b1.y0;
+            if (b1.x1 > b0.x1) b0.x1 = b1.x1;
+            if (b1.y1 > b0.y1) b0.y1 = b1.y1;
+        }
+        b0.x0 -= margin; b0.y0 -= margin; b0.x1 += margin; b0.y1 += margin;
+        boxes[i] = b0;
+    }
+    use_sweep = w->def.broadphase == LC_BROADPHASE_SORT_AND_SWEEP ||
+                (w->def.broadphase == LC_BROADPHASE_AUTO && n >= w->def.broadphase_threshold);
+    if (!use_sweep) {
+        w->last.brute_force_steps++;
+        for (i = 0; i < n; ++i)
+            for (j = i + 1; j < n; ++j) {
+                if (w->is_static[i] && w->is_static[j]) continue;
+                if (!overlap(&boxes[i], &boxes[j])) continue;
+                count = add_pair(buf, count, i, j);
+                if (count < 0) return -1;
+            }
+    } else {
+        w->last.sort_and_sweep_steps++;
+        qsort(boxes, (size_t)n, sizeof(box), cmp_box);
+        for (i = 0; i < n; ++i)
+            for (j = i + 1; j < n && boxes[j].x0 <= boxes[i].x1; ++j) {
+                int a = boxes[i].row, b = boxes[j].row;
+                if (w->is_static[a] && w->is_static[b]) continue;
+                if (!overlap(&boxes[i], &boxes[j])) continue;
+                count = add_pair(buf, count, a, b);
+                if (count < 0) return -1;
+            }
+        /* same pair order as brute force, so results do not depend on the broadphase */
+        if (count > 1) qsort(buf->p, (size_t)count, 2 * sizeof(int), cmp_pair);
+    }
+    w->last.broadphase_pairs += (uint64_t)count;
+    return count;
+}

@@ -1,0 +1,151 @@
+/* Resting contact forces (Baraff): relative normal accelerations a = A f + b with f >= 0, a >= 0,
+ * f.a = 0, solved per group of touches that share moving bodies. */
+#include <math.h>
+#include <string.h>
+#include "world.h"
+
+/* Delta normal velocity (or acceleration) at touch i per unit normal impulse (or force) at touch j. */
+static double response(const lc_world *w, const lc_touch *ti, const lc_touch *tj)
+{
+    double sum = 0.0;
+    int bodies_i[2], bodies_j[2], x, y;
+    bodies_i[0] = ti->a; bodies_i[1] = ti->b;
+    bodies_j[0] = tj->a; bodies_j[1] = tj->b;
+    for (x = 0; x < 2; ++x) {
+        int body = bodies_i[x];
+        double si = x == 0 ? 1.0 : -1.0;
+        lc_vec2 ri = x == 0 ? ti->ra : ti->rb;
+        if (w->is_static[body]) continue;
+        for (y = 0; y < 2; ++y) {
+            double sj = y == 0 ? 1.0 : -1.0;
+            lc_vec2 rj = y == 0 ? tj->ra : tj->rb;
+            if (bodies_j[y] != body) continue;
+            sum += si * sj * (lc_dot(ti->n, tj->n) * w->inv_mass[body] +
+                              lc_cross(ri, ti->n) * lc_cross(rj, tj->n) * w->inv_inertia[body]);
+        }
+    }
+    return sum;
+}
+
+void lc_response_matrix(const lc_world *w, const lc_touch *t, int n, double *A)
+{
+    int i, j;
+    for (i = 0; i < n; ++i)
+        for (j = i; j < n; ++j) {
+            double v = response(w, &t[i], &t[j]);
+            A[i * n + j] = v;
+            A[j * n + i] = v;
+        }
+}
+
+/* Union-find over body rows; static bodies never join groups (they do not transmit motion). */
+static int find(int *parent, int x)
+{
+    while (parent[x] != x) {
+        parent[x] = parent[parent[x]];
+        x = parent[x];
+    }
+    return x;
+}
+
+/* Relative normal acceleration at a touch from the current (non-contact) accelerations. */
+static double free_normal_acceleration(const lc_world *w, const double *state, const lc_touch *t, const double *acc)
+{
+    const double *sa = &state[t->a * 6], *sb = &state[t->b * 6];
+    const double *aa = &acc[t->a * 3], *ab = &acc[t->b * 3];
+    double wa = sa[SW], wb = sb[SW];
+    lc_vec2 acc_a = lc_v(0, 0), acc_b = lc_v(0, 0), va, vb;
+    if (!w->is_static[t->a])
+        acc_a = lc_sub(lc_add(lc_v(aa[0], aa[1]), lc_wcross(aa[2], t->ra)), lc_scale(t->ra, wa * wa));
+    if (!w->is_static[t->b])
+        acc_b = lc_sub(lc_add(lc_v(ab[0], ab[1]), lc_wcross(ab[2], t->rb)), lc_scale(t->rb, wb * wb));
+    va = lc_add(lc_v(sa[SVX], sa[SVY]), lc_wcross(wa, t->ra));
+    vb = lc_add(lc_v(sb[SVX], sb[SVY]), lc_wcross(wb, t->rb));
+    /* d'' = n.(a_pA - a_pB) + 2 (omega_B x n).(v_pA - v_pB): the edge's normal turns with body B */
+    return lc_dot(t->n, lc_sub(acc_a, acc_b)) + 2.0 * lc_dot(lc_wcross(wb, t->n), lc_sub(va, vb));
+}
+
+int lc_contact_forces(lc_world *w, const double *state, lc_touch *touches, int n, double *acc)
+{
+    int *parent, *order, *group;
+    int i, g0, rows = w->count;
+    double h = w->step_dt > 0.0 ? w->step_dt : 1e-3;
+    double kv = 0.0, kd = 0.0;
+    lc_lcp_options opt;
+    if (n == 0) return 0;
+    if (w->def.stabilization == LC_STABILIZE_VELOCITY) kv = 1.0 / h;
+    if (w->def.stabilization == LC_STABILIZE_VELOCITY_AND_DISTANCE) { kv = 2.0 / h; kd = 1.0 / (h * h); }
+    opt = lc_lcp_default_options();
+    opt.exact_max = w->def.lcp_exact_max;
+    opt.max_iterations = w->def.lcp_max_iterations;
+    opt.tolerance = w->def.lcp_tolerance;
+    opt.regularization = 1e-12;
+
+    parent = lc_buf_get(&w->b_island, (size_t)(rows + 2 * n) * sizeof(int));
+    if (parent == NULL) return -1;
+    order = parent + rows;
+    group = order + n;
+    for (i = 0; i < rows; ++i) parent[i] = i;
+    for (i = 0; i < n; ++i) {
+        lc_touch *t = &touches[i];
+        lc_touch_update(w, state, t);
+        if (!w->is_static[t->a] && !w->is_static[t->b]) {
+            int ra = find(parent, t->a), rb = find(parent, t->b);
+            if (ra != rb) parent[ra < rb ? rb : ra] = ra < rb ? ra : rb;
+        }
+    }
+    for (i = 0; i < n; ++i) {
+        lc_touch *t = &touches[i];
+        group[i] = find(parent, w->is_static[t->a] ? t->b : t->a);
+        order[i] = i;
+    }
+    /* stable insertion sort of touch indices by group keeps the original order inside a group */
+    for (i = 1; i < n; ++i) {
+        int v = order[i], j = i - 1;
+        while (j >= 0 && group[order[j]] > group[v]) { order[j + 1] = order[j]; --j; }
+        order[j + 1] = v;
+    }
+    for (g0 = 0; g0 < n;) {
+        int g1 = g0, m, j;
+        double *A, *b, *f;
+        lc_touch *sub;
+        lc_lcp_result res;
+        while (g1 < n && group[order[g1]] == group[order[g0]]) ++g1;
+        m = g1 - g0;
+        sub = lc_buf_get(&w->b_rest, (size_t)m * sizeof(lc_touch));
+        A = lc_buf_get(&w->b_mat, (size_t)m * (size_t)m * sizeof(double));
+        b = lc_buf_get(&w->b_vec, (size_t)m * sizeof(double));
+        f = lc_buf_get(&w->b_vec2, (size_t)m * sizeof(double));
+        if (!sub || !A || !b || !f) return -1;
+        for (j = 0; j < m; ++j) sub[j] = touches[order[g0 + j]];
+        lc_response_matrix(w, sub, m, A);
+        for (j = 0; j < m; ++j) {
+            b[j] = free_normal_acceleration(w, state, &sub[j], acc) + kv * sub[j].vn +
+                   kd * (sub[j].gap - w->def.contact_gap);
+            f[j] = 0.0;
+        }
+        lc_lcp_solve(m, A, b, f, NULL, &opt, w->lcp, &res);
+        w->last.contact_solves++;
+        w->last.contact_solve_iterations += (uint64_t)res.iterations;
+        w->last.resting_contacts += (uint64_t)m;
+        if (res.residual > w->last.max_lcp_residual) w->last.max_lcp_residual = res.residual;
+        for (j = 0; j < m; ++j) {
+            lc_touch *t = &touches[order[g0 + j]];
+            double fj = f[j] > 0.0 && isfinite(f[j]) ? f[j] : 0.0;
+            lc_vec2 F = lc_scale(t->n, fj);
+            t->value = fj;
+            if (!w->is_static[t->a]) {
+                acc[t->a * 3 + 0] += F.x * w->inv_mass[t->a];
+                acc[t->a * 3 + 1] += F.y * w->inv_mass[t->a];
+                acc[t->a * 3 + 2] += lc_cross(t->ra, F) * w->inv_inertia[t->a];
+            }
+            if (!w->is_static[t->b]) {
+                acc[t->b * 3 + 0] -= F.x * w->inv_mass[t->b];
+                acc[t->b * 3 + 1] -= F.y * w->inv_mass[t->b];
+                acc[t->b * 3 + 2] -= lc_cross(t->rb, F) * w->inv_inertia[t->b];
+            }
+        }
+        g0 = g1;
+    }
+    return 0;
+}

@@ -1,0 +1,132 @@
+/* Applied forces: gravity, damping, thrusters, springs and external force/torque, as accelerations. */
+#include <math.h>
+#include "world.h"
+
+static void spring_force(const lc_world *w, const double *state, const lc_spring_def *d, int ra, int rb,
+                         lc_vec2 *force_on_a, lc_vec2 *pa, lc_vec2 *pb, lc_vec2 *arm_a, lc_vec2 *arm_b)
+{
+    const double *sa = &state[ra * 6];
+    double ca = cos(sa[SA]), sna = sin(sa[SA]);
+    lc_vec2 va, vb, f, dlt;
+    double len;
+    *arm_a = lc_rot(ca, sna, lc_sub(d->point_a, w->shape[ra].center_offset));
+    *pa = lc_add(lc_v(sa[SX], sa[SY]), *arm_a);
+    va = lc_add(lc_v(sa[SVX], sa[SVY]), lc_wcross(sa[SW], *arm_a));
+    if (rb < 0) {
+        *pb = d->point_b;
+        *arm_b = lc_v(0, 0);
+        vb = lc_v(0, 0);
+    } else {
+        const double *sb = &state[rb * 6];
+        double cb = cos(sb[SA]), snb = sin(sb[SA]);
+        *arm_b = lc_rot(cb, snb, lc_sub(d->point_b, w->shape[rb].center_offset));
+        *pb = lc_add(lc_v(sb[SX], sb[SY]), *arm_b);
+        vb = lc_add(lc_v(sb[SVX], sb[SVY]), lc_wcross(sb[SW], *arm_b));
+    }
+    dlt = lc_sub(*pa, *pb);
+    len = sqrt(lc_dot(dlt, dlt));
+    /* Zero rest length needs no direction (F = -k * delta), which keeps the mouse spring smooth at 0. */
+    if (d->rest_length == 0.0) f = lc_scale(dlt, -d->stiffness);
+    else if (len > 0.0) f = lc_scale(dlt, -d->stiffness * (len - d->rest_length) / len);
+    else f = lc_v(0, 0);
+    /* Damping on the full relative velocity of the two points, as the seed's spring does. */
+    f = lc_sub(f, lc_scale(lc_sub(va, vb), d->damping));
+    *force_on_a = f;
+}
+
+void lc_applied_accelerations(const lc_world *w, const double *state, const int *rows, int n, double *acc)
+{
+    int i, k;
+    const lc_world_def *def = &w->def;
+    for (i = 0; i < n; ++i) {
+        int r = rows[i];
+        const double *s = &state[r * 6];
+        double m = w->mass[r], fx, fy, tq;
+        double *a = &acc[r * 3];
+        if (w->is_static[r]) { a[0] = a[1] = a[2] = 0.0; continue; }
+        fx = m * def->gravity.x + w->ext_force[r].x - def->damping * s[SVX];
+        fy = m * def->gravity.y + w->ext_force[r].y - def->damping * s[SVY];
+        tq = w->ext_torque[r] - def->damping * def->damping_rotation_ratio * s[SW];
+        if (w->thruster_count[r] > 0) {
+            double c = cos(s[SA]), sn = sin(s[SA]);
+            for (k = 0; k < w->thruster_count[r]; ++k) {
+                const lc_thruster *t = &w->thrusters[r][k];
+                lc_vec2 f, arm;
+                if (t->level == 0.0) continue;
+                f = lc_scale(lc_rot(c, sn, t->direction), t->magnitude * t->level);
+                arm = lc_rot(c, sn, t->point);
+                fx += f.x;
+                fy += f.y;
+                tq += lc_cross(arm, f);
+            }
+        }
+        a[0] = fx;   /* forces first; divided by mass after springs are added */
+        a[1] = fy;
+        a[2] = tq;
+    }
+    /* Springs touch rows that may or may not be in the list; only listed rows are written. A row's
+     * list membership is checked through a mark in acc: rows not listed are left untouched. */
+    for (k = 0; k < w->spring_count; ++k) {
+        const lc_spring_def *d = &w->springs[k].def;
+        int ra = lc_world_body_index(w, d->body_a);
+        int rb = d->body_b == LC_WORLD_ANCHOR ? -1 : lc_world_body_index(w, d->body_b);
+        int in_a = 0, in_b = 0;
+        lc_vec2 f, pa, pb, arm_a, arm_b;
+        for (i = 0; i < n; ++i) {
+            if (rows[i] == ra) in_a = 1;
+            if (rb >= 0 && rows[i] == rb) in_b = 1;
+        }
+        if (!in_a && !in_b) continue;
+        spring_force(w, state, d, ra, rb, &f, &pa, &pb, &arm_a, &arm_b);
+        if (in_a) {
+            acc[ra * 3 + 0] += f.x;
+            acc[ra * 3 + 1] += f.y;
+            acc[ra * 3 + 2] += lc_cross(arm_a, f);
+        }
+        if (in_b && !w->is_static[rb]) {
+            acc[rb * 3 + 0] -= f.x;
+            acc[rb * 3 + 1] -= f.y;
+            acc[rb * 3 + 2] -= lc_cross(arm_b, f);
+        }
+    }
+    for (i = 0; i < n; ++i) {
+        int r = rows[i];
+        if (w->is_static[r]) continue;
+        acc[r * 3 + 0] *= w->inv_mass[r];
+        acc[r * 3 + 1] *= w->inv_mass[r];
+        acc[r * 3 + 2] *= w->inv_inertia[r];
+    }
+}
+
+int lc_body_forces_constant(const lc_world *w, int row)
+{
+    int k;
+    lc_body_id id = w->ids[row];
+    if (w->def.damping != 0.0) return 0;
+    for (k = 0; k < w->thruster_count[row]; ++k)
+        if (w->thrusters[row][k].level != 0.0) return 0;
+    for (k = 0; k < w->spring_count; ++k)
+        if (w->springs[k].def.body_a == id || w->springs[k].def.body_b == id) return 0;
+    return 1;
+}
+
+/* Potential energy of the springs (J), used by energy.c. */
+double lc_spring_energy(const lc_world *w, const double *state);
+double lc_spring_energy(const lc_world *w, const double *state)
+{
+    int k;
+    double e = 0.0;
+    for (k = 0; k < w->spring_count; ++k) {
+        const lc_spring_def *d = &w->springs[k].def;
+        int ra = lc_world_body_index(w, d->body_a);
+        int rb = d->body_b == LC_WORLD_ANCHOR ? -1 : lc_world_body_index(w, d->body_b);
+        lc_vec2 f, pa, pb, arm_a, arm_b, dl;
+        double len, stretch;
+        spring_force(w, state, d, ra, rb, &f, &pa, &pb, &arm_a, &arm_b);
+        dl = lc_sub(pa, pb);
+        len = sqrt(lc_dot(dl, dl));
+        stretch = len - d->rest_length;
+        e += 0.5 * d->stiffness * stretch * stretch;
+    }
+    return e;
+}

@@ -1,0 +1,149 @@
+/* Collision impulses: eq. 11 of the seed generalised to several points as a complementarity problem
+ * (a = A j + b >= 0, j >= 0, j.a = 0 with b = (1 + e) v_n), resolved either serially, one touching
+ * body pair at a time, or simultaneously. The wall limit is A's zero inverse mass for static bodies. */
+#include <math.h>
+#include <string.h>
+#include "world.h"
+
+static double normal_velocity(const double *state, const lc_touch *t)
+{
+    const double *sa = &state[t->a * 6], *sb = &state[t->b * 6];
+    lc_vec2 va = lc_add(lc_v(sa[SVX], sa[SVY]), lc_wcross(sa[SW], t->ra));
+    lc_vec2 vb = lc_add(lc_v(sb[SVX], sb[SVY]), lc_wcross(sb[SW], t->rb));
+    return lc_dot(t->n, lc_sub(va, vb));
+}
+
+static void apply_impulse(const lc_world *w, double *state, const lc_touch *t, lc_vec2 J)
+{
+    if (!w->is_static[t->a]) {
+        double *s = &state[t->a * 6];
+        s[SVX] += J.x * w->inv_mass[t->a];
+        s[SVY] += J.y * w->inv_mass[t->a];
+        s[SW] += lc_cross(t->ra, J) * w->inv_inertia[t->a];
+    }
+    if (!w->is_static[t->b]) {
+        double *s = &state[t->b * 6];
+        s[SVX] -= J.x * w->inv_mass[t->b];
+        s[SVY] -= J.y * w->inv_mass[t->b];
+        s[SW] -= lc_cross(t->rb, J) * w->inv_inertia[t->b];
+    }
+}
+
+/* Coulomb friction for one point after its normal impulse jn: stop the sliding if the cone allows. */
+static void apply_friction(const lc_world *w, double *state, lc_touch *t, double jn)
+{
+    const double *sa = &state[t->a * 6], *sb = &state[t->b * 6];
+    lc_vec2 tan = lc_v(-t->n.y, t->n.x), va, vb;
+    double vt, k = 0.0, jt, lim = t->friction * jn;
+    if (!(lim > 0.0)) return;
+    va = lc_add(lc_v(sa[SVX], sa[SVY]), lc_wcross(sa[SW], t->ra));
+    vb = lc_add(lc_v(sb[SVX], sb[SVY]), lc_wcross(sb[SW], t->rb));
+    vt = lc_dot(tan, lc_sub(va, vb));
+    if (!w->is_static[t->a]) k += w->inv_mass[t->a] + lc_cross(t->ra, tan) * lc_cross(t->ra, tan) * w->inv_inertia[t->a];
+    if (!w->is_static[t->b]) k += w->inv_mass[t->b] + lc_cross(t->rb, tan) * lc_cross(t->rb, tan) * w->inv_inertia[t->b];
+    if (!(k > 0.0)) return;
+    jt = -vt / k;
+    if (jt > lim) jt = lim;
+    if (jt < -lim) jt = -lim;
+    t->tangent += jt;
+    apply_impulse(w, state, t, lc_scale(tan, jt));
+}
+
+/* Solves the impulse problem for touches t[0..n) with per-point restitution (use_e) and applies it.
+ * Returns the number of points that received a positive impulse, or -1. */
+static int solve_block(lc_world *w, double *state, lc_touch *t, int n, int use_e)
+{
+    double *A = lc_buf_get(&w->b_mat, (size_t)n * (size_t)n * sizeof(double));
+    double *b = lc_buf_get(&w->b_vec, (size_t)n * sizeof(double));
+    double *j = lc_buf_get(&w->b_vec2, (size_t)n * sizeof(double));
+    lc_lcp_options opt;
+    lc_lcp_result res;
+    int i, hits = 0;
+    if (!A || !b || !j) return -1;
+    opt = lc_lcp_default_options();
+    opt.exact_max = w->def.lcp_exact_max;
+    opt.max_iterations = w->def.lcp_max_iterations;
+    opt.tolerance = w->def.lcp_tolerance;
+    opt.regularization = 1e-12;
+    lc_response_matrix(w, t, n, A);
+    for (i = 0; i < n; ++i) {
+        double vn = normal_velocity(state, &t[i]);
+        /* restitution only for real approach; slow touches are made to stop (e = 0) so that
+         * settling ends instead of bouncing ever smaller (the seed's Zeno "stuck" case) */
+        double e = use_e && vn < -w->def.resting_speed ? t[i].elasticity : 0.0;
+        b[i] = vn + e * (vn < 0.0 ? vn : 0.0);
+        j[i] = 0.0;
+    }
+    if (n == 1) {
+        /* eq. 11 directly: j = -(1 + e) v_n / (1/m_a + 1/m_b + (r_a x n)^2/I_a + (r_b x n)^2/I_b) */
+        j[0] = b[0] < 0.0 && A[0] > 0.0 ? -b[0] / A[0] : 0.0;
+        res.iterations = 1;
+    } else {
+        lc_lcp_solve(n, A, b, j, NULL, &opt, w->lcp, &res);
+    }
+    w->last.impulse_solves++;
+    for (i = 0; i < n; ++i) {
+        double ji = j[i] > 0.0 && isfinite(j[i]) ? j[i] : 0.0;
+        if (ji <= 0.0) continue;
+        apply_impulse(w, state, &t[i], lc_scale(t[i].n, ji));
+        t[i].value += ji;
+        hits++;
+    }
+    for (i = 0; i < n; ++i)
+        if (j[i] > 0.0 && isfinite(j[i])) apply_friction(w, state, &t[i], j[i]);
+    return hits;
+}
+
+static int same_pair(const lc_touch *x, const lc_touch *y)
+{
+    return (x->a == y->a && x->b == y->b) || (x->a == y->b && x->b == y->a);
+}
+
+int lc_resolve_impacts(lc_world *w, double *state, lc_touch *t, int n)
+{
+    int i, hits = 0, iter;
+    /* a tiny fraction of the approach speed counts as "still approaching": round-off, not physics */
+    double vmax = 0.0, eps;
+    if (n == 0) return 0;
+    for (i = 0; i < n; ++i) {
+        lc_touch_update(w, state, &t[i]);
+        t[i].vn_pre = t[i].vn;
+        t[i].value = 0.0;
+        t[i].tangent = 0.0;
+        if (-t[i].vn > vmax) vmax = -t[i].vn;
+    }
+    eps = 1e-12 * (1.0 + vmax);
+    if (w->def.impact_mode == LC_IMPACT_SIMULTANEOUS) {
+        int k = solve_block(w, state, t, n, 1);
+        if (k < 0) return -1;
+        hits += k;
+    } else {
+        for (iter = 0; iter < w->def.max_serial_iterations; ++iter) {
+            int worst = -1, start, end, k;
+            double vworst = -eps;
+            for (i = 0; i < n; ++i) {
+                double vn = normal_velocity(state, &t[i]);
+                if (vn < vworst) { vworst = vn; worst = i; }
+            }
+            if (worst < 0) break;
+            /* the touches of one body pair are contiguous (collected per pair): resolve them together,
+             * so a flat face landing on two corners gets one symmetric impulse and no spin */
+            start = end = worst;
+            while (start > 0 && same_pair(&t[start - 1], &t[worst])) --start;
+            while (end + 1 < n && same_pair(&t[end + 1], &t[worst])) ++end;
+            w->last.serial_iterations++;
+            k = solve_block(w, state, t + start, end - start + 1, 1);
+            if (k < 0) return -1;
+            hits += k;
+            if (k == 0) break;   /* the solver found nothing to do: avoid spinning */
+        }
+        if (iter == w->def.max_serial_iterations) {
+            /* e.g. e = 1 between bodies wedged against each other: close the event inelastically */
+            int k = solve_block(w, state, t, n, 0);
+            if (k < 0) return -1;
+            hits += k;
+            w->last.inelastic_fallbacks++;
+        }
+    }
+    return hits;
+}

@@ -1,0 +1,201 @@
+/* Narrow phase: vertex-against-edge geometry. Touches (resting contacts and impact points) and
+ * crossings (a vertex whose path entered another body during a step), as in the seed's vertex tests. */
+#include <math.h>
+#include "world.h"
+
+typedef struct frame { double x, y, c, s; } frame;
+
+static frame frame_of(const double *state, int row)
+{
+    frame f;
+    const double *s = &state[row * 6];
+    f.x = s[SX];
+    f.y = s[SY];
+    f.c = cos(s[SA]);
+    f.s = sin(s[SA]);
+    return f;
+}
+
+/* World point of body-frame point p. */
+static lc_vec2 to_world(frame f, lc_vec2 p) { return lc_add(lc_v(f.x, f.y), lc_rot(f.c, f.s, p)); }
+/* Body-frame coordinates of world point p. */
+static lc_vec2 to_local(frame f, lc_vec2 p) { return lc_rot_inv(f.c, f.s, lc_v(p.x - f.x, p.y - f.y)); }
+
+static double edge_distance(const lc_shape *sh, int k, lc_vec2 local)
+{
+    return lc_dot(sh->n[k], lc_sub(local, sh->v[k]));
+}
+
+/* Position along edge k as a fraction of its length (0 at v[k], 1 at v[k+1]). */
+static double edge_param(const lc_shape *sh, int k, lc_vec2 local, double *len_out)
+{
+    lc_vec2 a = sh->v[k], b = sh->v[(k + 1) % sh->count];
+    lc_vec2 e = lc_sub(b, a);
+    double len2 = lc_dot(e, e);
+    *len_out = sqrt(len2);
+    return lc_dot(lc_sub(local, a), e) / len2;
+}
+
+double lc_vertex_edge_gap(const lc_world *w, const double *state, int a, int vertex, int b, int edge)
+{
+    frame fa = frame_of(state, a), fb = frame_of(state, b);
+    lc_vec2 p = to_world(fa, w->shape[a].v[vertex]);
+    return edge_distance(&w->shape[b], edge, to_local(fb, p));
+}
+
+void lc_touch_update(const lc_world *w, const double *state, lc_touch *t)
+{
+    frame fa = frame_of(state, t->a), fb = frame_of(state, t->b);
+    const double *sa = &state[t->a * 6], *sb = &state[t->b * 6];
+    lc_vec2 va, vb;
+    t->ra = lc_rot(fa.c, fa.s, w->shape[t->a].v[t->vertex]);
+    t->p = lc_add(lc_v(fa.x, fa.y), t->ra);
+    t->n = lc_rot(fb.c, fb.s, w->shape[t->b].n[t->edge]);
+    t->rb = lc_sub(t->p, lc_v(fb.x, fb.y));
+    t->gap = lc_dot(t->n, lc_sub(t->p, to_world(fb, w->shape[t->b].v[t->edge])));
+    va = lc_add(lc_v(sa[SVX], sa[SVY]), lc_wcross(sa[SW], t->ra));
+    vb = lc_add(lc_v(sb[SVX], sb[SVY]), lc_wcross(sb[SW], t->rb));
+    t->vn = lc_dot(t->n, lc_sub(va, vb));
+}
+
+static double mix(lc_mix_rule r, double x, double y)
+{
+    switch (r) {
+    case LC_MIX_MIN: return x < y ? x : y;
+    case LC_MIX_MAX: return x > y ? x : y;
+    case LC_MIX_MEAN: return 0.5 * (x + y);
+    case LC_MIX_GEOMETRIC: return sqrt(x * y);
+    }
+    return x < y ? x : y;
+}
+
+/* Touches of the vertices of body `a` against the edges of body `b`. */
+static int touches_one_way(const lc_world *w, const double *state, int a, int b, double max_gap,
+                           lc_buf *buf, int count, int first_of_pair)
+{
+    const lc_shape *sa = &w->shape[a], *sb = &w->shape[b];
+    frame fa = frame_of(state, a), fb = frame_of(state, b);
+    int i, k, j;
+    for (i = 0; i < sa->count; ++i) {
+        lc_vec2 local = to_local(fb, to_world(fa, sa->v[i]));
+        double best = -INFINITY, len, u;
+        int best_k = -1;
+        lc_touch *t;
+        for (k = 0; k < sb->count; ++k) {
+            double d = edge_distance(sb, k, local);
+            if (d > best) { best = d; best_k = k; }
+        }
+        if (!(best < max_gap)) continue;
+        u = edge_param(sb, best_k, local, &len);
+        /* beyond the edge's ends by more than the touch distance: a corner-corner near miss */
+        if (u * len < -max_gap || (u - 1.0) * len > max_gap) continue;
+        /* a point already recorded for this pair at (nearly) the same place is the same contact */
+        {
+            lc_vec2 p = to_world(fa, sa->v[i]);
+            int dup = 0;
+            t = (lc_touch *)buf->p;
+            for (j = first_of_pair; j < count; ++j) {
+                lc_vec2 d = lc_sub(t[j].p, p);
+                if (lc_dot(d, d) < max_gap * max_gap) { dup = 1; break; }
+            }
+            if (dup) continue;
+        }
+        t = lc_buf_get(buf, (size_t)(count + 1) * sizeof(lc_touch));
+        if (t == NULL) return -1;
+        t += count;
+        t->a = a;
+        t->b = b;
+        t->vertex = i;
+        t->edge = best_k;
+        t->elasticity = mix(w->def.elasticity_rule, w->elasticity[a], w->elasticity[b]);
+        t->friction = mix(w->def.friction_rule, w->friction[a], w->friction[b]);
+        t->value = 0.0;
+        t->vn_pre = 0.0;
+        t->target_vn = 0.0;
+        lc_touch_update(w, state, t);
+        count++;
+    }
+    return count;
+}
+
+int lc_collect_touches(const lc_world *w, const double *state, int a, int b, double max_gap,
+                       lc_buf *buf, int count)
+{
+    int first = count;
+    if (w->is_static[a] && w->is_static[b]) return count;
+    count = touches_one_way(w, state, a, b, max_gap, buf, count, first);
+    if (count < 0) return count;
+    return touches_one_way(w, state, b, a, max_gap, buf, count, first);
+}
+
+static int crossings_one_way(const lc_world *w, const double *s0, const double *s1, int a, int b,
+                             lc_buf *buf, int count)
+{
+    const lc_shape *sa = &w->shape[a], *sb = &w->shape[b];
+    frame fa0 = frame_of(s0, a), fb0 = frame_of(s0, b), fa1 = frame_of(s1, a), fb1 = frame_of(s1, b);
+    /* Penetrations shallower than half the contact gap are round-off around a resting contact (held at
+     * contact_gap), not impacts; a vertex deeper than that at the start is an old overlap left to
+     * stabilisation. */
+    double start_tol = -0.5 * w->def.contact_gap;
+    /* entering the contact-gap band from outside it is an impact too: impacts are handled at contact_gap */
+    double band = w->def.contact_gap - w->def.toi_distance_tolerance;
+    int i, k;
+    for (i = 0; i < sa->count; ++i) {
+        lc_vec2 l0 = to_local(fb0, to_world(fa0, sa->v[i]));
+        lc_vec2 l1 = to_local(fb1, to_world(fa1, sa->v[i]));
+        double dmax0 = -INFINITY, dmax1 = -INFINITY, first_s = INFINITY;
+        int hit = -1, deepest = -1;
+        for (k = 0; k < sb->count; ++k) {
+            double d0 = edge_distance(sb, k, l0), d1 = edge_distance(sb, k, l1);
+            if (d0 > dmax0) dmax0 = d0;
+            if (d1 > dmax1) { dmax1 = d1; deepest = k; }
+            /* the path (straight in b's frame) crosses edge k's line inward within the edge */
+            /* a vertex resting near contact_gap wobbles by round-off; only one clearly outside the band
+             * (beyond twice the gap) is caught entering it */
+            double level = d0 > 2.0 * w->def.contact_gap ? band : start_tol;
+            if (d0 >= start_tol && d1 < level) {
+                double s = (d0 - level) / (d0 - d1), len, u;
+                lc_vec2 x = lc_add(l0, lc_scale(lc_sub(l1, l0), s));
+                u = edge_param(sb, k, x, &len);
+                if (u * len >= -w->def.contact_distance && (u - 1.0) * len <= w->def.contact_distance && s < first_s) {
+                    first_s = s;
+                    hit = k;
+                }
+            }
+        }
+        if (dmax0 < start_tol) continue;          /* started inside */
+        if (hit < 0) {
+            if (!(dmax1 < start_tol)) continue;   /* ended outside and never crossed an edge */
+            hit = deepest;                        /* rotation carried it in: least-penetrated edge */
+        } else if (!(dmax1 < start_tol)) {
+            /* crossed an edge line but ended outside: only a tunnel if it went through the body,
+             * i.e. the crossing point was inside every other edge's half-plane */
+            double s = first_s;
+            lc_vec2 x = lc_add(l0, lc_scale(lc_sub(l1, l0), s));
+            int inside = 1;
+            for (k = 0; k < sb->count; ++k)
+                if (k != hit && edge_distance(sb, k, x) > w->def.contact_distance) { inside = 0; break; }
+            if (!inside) continue;
+        }
+        {
+            lc_crossing *c = lc_buf_get(buf, (size_t)(count + 1) * sizeof(lc_crossing));
+            if (c == NULL) return -1;
+            c[count].a = a;
+            c[count].b = b;
+            c[count].vertex = i;
+            c[count].edge = hit;
+            c[count].toi = 0.0;
+            count++;
+        }
+    }
+    return count;
+}
+
+int lc_find_crossings(const lc_world *w, const double *s0, const double *s1, int a, int b,
+                      lc_buf *buf, int count)
+{
+    if (w->is_static[a] && w->is_static[b]) return count;
+    count = crossings_one_way(w, s0, s1, a, b, buf, count);
+    if (count < 0) return count;
+    return crossings_one_way(w, s0, s1, b, a, buf, count);
+}

@@ -1,0 +1,116 @@
+/* Convex polygons: validation and mass properties computed from the area (uniform density). */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+#include "world.h"
+
+static const double LC_PI = 3.14159265358979323846;
+
+lc_status lc_shape_build(lc_shape *out, const lc_vec2 *v, int count, char *why, size_t why_len)
+{
+    lc_vec2 p[LC_MAX_POLYGON_VERTICES];
+    double area2 = 0.0, cx = 0.0, cy = 0.0, scale = 0.0, j = 0.0;
+    int i, sign = 0;
+    if (v == NULL) {
+        snprintf(why, why_len, "vertices is NULL");
+        return LC_ERR_NULL;
+    }
+    if (count < 3 || count > LC_MAX_POLYGON_VERTICES) {
+        snprintf(why, why_len, "vertex_count %d is outside [3, %d]", count, LC_MAX_POLYGON_VERTICES);
+        return LC_ERR_BAD_POLYGON;
+    }
+    for (i = 0; i < count; ++i) {
+        if (!isfinite(v[i].x) || !isfinite(v[i].y)) {
+            snprintf(why, why_len, "vertex %d is not finite", i);
+            return LC_ERR_NOT_FINITE;
+        }
+        if (fabs(v[i].x) > 1e6 || fabs(v[i].y) > 1e6) {
+            snprintf(why, why_len, "vertex %d is farther than 1e6 m from the local origin", i);
+            return LC_ERR_OUT_OF_RANGE;
+        }
+        p[i] = v[i];
+        scale = fmax(scale, fmax(fabs(v[i].x), fabs(v[i].y)));
+    }
+    for (i = 0; i < count; ++i) area2 += lc_cross(p[i], p[(i + 1) % count]);
+    /* Accept either winding; store counter-clockwise so edge normals point outward. */
+    if (area2 < 0.0) {
+        for (i = 0; i < count / 2; ++i) {
+            lc_vec2 t = p[i];
+            p[i] = p[count - 1 - i];
+            p[count - 1 - i] = t;
+        }
+        area2 = -area2;
+    }
+    /* Degenerate: zero area relative to the polygon's size (collinear or repeated points). */
+    if (!(area2 > 1e-12 * scale * scale) || scale == 0.0) {
+        snprintf(why, why_len, "polygon is degenerate (area %.3g m^2)", area2 / 2.0);
+        return LC_ERR_BAD_POLYGON;
+    }
+    {
+        double turning = 0.0;
+        for (i = 0; i < count; ++i) {
+            lc_vec2 e0 = lc_sub(p[(i + 1) % count], p[i]);
+            lc_vec2 e1 = lc_sub(p[(i + 2) % count], p[(i + 1) % count]);
+            double l0 = sqrt(lc_dot(e0, e0)), l1 = sqrt(lc_dot(e1, e1));
+            double c;
+            if (l0 <= 1e-9 * scale || l1 <= 1e-9 * scale) {
+                snprintf(why, why_len, "vertices %d and %d coincide", (i + 1) % count,
+                         l0 <= 1e-9 * scale ? i : (i + 2) % count);
+                return LC_ERR_BAD_POLYGON;
+            }
+            c = lc_cross(e0, e1) / (l0 * l1);
+            if (c <= 1e-9) {
+                snprintf(why, why_len, c > -1e-9 ? "vertex %d is collinear with its neighbours"
+                                                 : "polygon is not convex at vertex %d",
+                         (i + 1) % count);
+                return LC_ERR_BAD_POLYGON;
+            }
+            if (sign == 0) sign = 1;
+            turning += atan2(lc_cross(e0, e1), lc_dot(e0, e1));
+        }
+        /* A star polygon turns left everywhere but winds more than once. */
+        if (fabs(turning - 2.0 * LC_PI) > 1e-6) {
+            snprintf(why, why_len, "polygon is self-intersecting (winds %.2f times)", turning / (2.0 * LC_PI));
+            return LC_ERR_BAD_POLYGON;
+        }
+    }
+    /* Centroid and polar moment of a uniform polygon from its triangle fan about the origin. */
+    for (i = 0; i < count; ++i) {
+        lc_vec2 a = p[i], b = p[(i + 1) % count];
+        double c = lc_cross(a, b);
+        cx += (a.x + b.x) * c;
+        cy += (a.y + b.y) * c;
+    }
+    cx /= 3.0 * area2;
+    cy /= 3.0 * area2;
+    memset(out, 0, sizeof *out);
+    out->count = count;
+    out->center_offset = lc_v(cx, cy);
+    out->area = area2 / 2.0;
+    for (i = 0; i < count; ++i) out->v[i] = lc_v(p[i].x - cx, p[i].y - cy);
+    for (i = 0; i < count; ++i) {
+        lc_vec2 a = out->v[i], b = out->v[(i + 1) % count];
+        lc_vec2 e = lc_sub(b, a);
+        double len = sqrt(lc_dot(e, e));
+        double c = lc_cross(a, b);
+        out->n[i] = lc_v(e.y / len, -e.x / len);
+        /* second moment of the triangle (0, a, b) about the centroid-origin, per unit area */
+        j += c * (lc_dot(a, a) + lc_dot(a, b) + lc_dot(b, b));
+        out->radius = fmax(out->radius, sqrt(lc_dot(a, a)));
+    }
+    out->unit_inertia = (j / 12.0) / out->area;
+    (void)sign;
+    return LC_OK;
+}
+
+lc_status lc_make_rectangle(double width, double height, lc_vec2 out[4])
+{
+    if (out == NULL) return LC_ERR_NULL;
+    if (!isfinite(width) || !isfinite(height)) return LC_ERR_NOT_FINITE;
+    if (!(width > 0.0) || !(height > 0.0) || width > 1e6 || height > 1e6) return LC_ERR_OUT_OF_RANGE;
+    out[0] = lc_v(-width / 2, -height / 2);
+    out[1] = lc_v(width / 2, -height / 2);
+    out[2] = lc_v(width / 2, height / 2);
+    out[3] = lc_v(-width / 2, height / 2);
+    return LC_OK;
+}

@@ -1,0 +1,272 @@
+/* The step: integrate, look for vertices that entered another body, back up to the earliest time of
+ * impact, apply the impulses there, and continue with the rest of the step. Time is never dropped. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include "world.h"
+
+/* Most a body may turn (rad) within one collision-checked interval. */
+#define LC_MAX_TRIAL_ROTATION 0.25
+
+/* Touches between all near pairs at `state` with gap < contact_distance, appended to buf from 0. */
+static int gather_touches(lc_world *w, const double *state, lc_buf *buf)
+{
+    int np = lc_broad_phase(w, state, state, w->def.contact_distance, &w->b_pairs), i, n = 0;
+    const int *pairs;
+    if (np < 0) return -1;
+    pairs = (const int *)w->b_pairs.p;
+    for (i = 0; i < np; ++i) {
+        n = lc_collect_touches(w, state, pairs[2 * i], pairs[2 * i + 1], w->def.contact_distance, buf, n);
+        if (n < 0) return -1;
+    }
+    return n;
+}
+
+/* Resting set: touching points that neither approach nor separate faster than resting_speed. */
+static int gather_resting(lc_world *w, const double *state)
+{
+    int n = gather_touches(w, state, &w->b_touch), i, k = 0;
+    lc_touch *t = (lc_touch *)w->b_touch.p;
+    if (n < 0) return -1;
+    for (i = 0; i < n; ++i)
+        if (fabs(t[i].vn) <= w->def.resting_speed) t[k++] = t[i];
+    return k;
+}
+
+static int find_root(int *parent, int x)
+{
+    while (parent[x] != x) { parent[x] = parent[parent[x]]; x = parent[x]; }
+    return x;
+}
+
+/* Impact set at the time of impact: every touch in the group of bodies connected by touches to the
+ * bodies of the impacting crossing (so an impact travels through a row of touching blocks). */
+static int gather_impact(lc_world *w, const double *state, const lc_crossing *c)
+{
+    int n = gather_touches(w, state, &w->b_impact), i, k = 0, have = 0;
+    int *parent;
+    lc_touch *t = (lc_touch *)w->b_impact.p;
+    int seed;
+    if (n < 0) return -1;
+    parent = lc_buf_get(&w->b_island, (size_t)w->count * sizeof(int));
+    if (parent == NULL) return -1;
+    for (i = 0; i < w->count; ++i) parent[i] = i;
+    for (i = 0; i < n; ++i) {
+        if (!w->is_static[t[i].a] && !w->is_static[t[i].b]) {
+            int ra = find_root(parent, t[i].a), rb = find_root(parent, t[i].b);
+            if (ra != rb) parent[ra < rb ? rb : ra] = ra < rb ? ra : rb;
+        }
+        if (t[i].a == c->a && t[i].vertex == c->vertex && t[i].b == c->b) {
+            /* at a corner two edges are equally near; the vertex came in through the crossing's edge */
+            if (t[i].edge != c->edge) {
+                t[i].edge = c->edge;
+                lc_touch_update(w, state, &t[i]);
+            }
+            have = 1;
+        }
+    }
+    seed = find_root(parent, w->is_static[c->a] ? c->b : c->a);
+    for (i = 0; i < n; ++i) {
+        int body = w->is_static[t[i].a] ? t[i].b : t[i].a;
+        if (find_root(parent, body) == seed) t[k++] = t[i];
+    }
+    if (!have) {
+        /* the crossing vertex was not found as a touch (e.g. it meets the other body's corner):
+         * use the crossing itself so the impact is never lost */
+        lc_touch *x = lc_buf_get(&w->b_impact, (size_t)(k + 1) * sizeof(lc_touch));
+        if (x == NULL) return -1;
+        memset(&x[k], 0, sizeof x[k]);
+        x[k].a = c->a;
+        x[k].b = c->b;
+        x[k].vertex = c->vertex;
+        x[k].edge = c->edge;
+        x[k].elasticity = fmin(w->elasticity[c->a], w->elasticity[c->b]);
+        x[k].friction = sqrt(w->friction[c->a] * w->friction[c->b]);
+        lc_touch_update(w, state, &x[k]);
+        k++;
+    }
+    return k;
+}
+
+static int push_contact(lc_world *w, const lc_touch *t, lc_contact_kind kind)
+{
+    lc_contact *c;
+    if (w->contact_count == w->contact_cap) {
+        int cap = w->contact_cap ? 2 * w->contact_cap : 32;
+        void *p = realloc(w->contacts, (size_t)cap * sizeof *w->contacts);
+        if (p == NULL) return -1;
+        w->contacts = p;
+        w->contact_cap = cap;
+    }
+    c = &w->contacts[w->contact_count++];
+    c->body_a = w->ids[t->a];
+    c->body_b = w->ids[t->b];
+    c->point = t->p;
+    c->normal = t->n;
+    c->gap = t->gap;
+    c->time = w->time;
+    c->kind = kind;
+    if (kind == LC_CONTACT_COLLISION) {
+        c->normal_velocity = t->vn_pre;
+        c->impulse = t->value;
+        c->tangent_impulse = t->tangent;
+        c->force = 0.0;
+    } else {
+        c->normal_velocity = t->vn;
+        c->impulse = 0.0;
+        c->tangent_impulse = 0.0;
+        c->force = t->value;
+    }
+    return 0;
+}
+
+static void add_counters(lc_counters *total, const lc_counters *last)
+{
+    total->steps += last->steps;
+    total->force_evaluations += last->force_evaluations;
+    total->analytic_advances += last->analytic_advances;
+    total->broadphase_pairs += last->broadphase_pairs;
+    total->brute_force_steps += last->brute_force_steps;
+    total->sort_and_sweep_steps += last->sort_and_sweep_steps;
+    total->collisions += last->collisions;
+    total->impulses += last->impulses;
+    total->toi_searches += last->toi_searches;
+    total->toi_iterations += last->toi_iterations;
+    total->serial_iterations += last->serial_iterations;
+    total->inelastic_fallbacks += last->inelastic_fallbacks;
+    total->resting_contacts += last->resting_contacts;
+    total->contact_solves += last->contact_solves;
+    total->contact_solve_iterations += last->contact_solve_iterations;
+    total->impulse_solves += last->impulse_solves;
+    if (last->max_lcp_residual > total->max_lcp_residual) total->max_lcp_residual = last->max_lcp_residual;
+}
+
+static lc_status step_failed(lc_world *w, const double *backup, double time0, lc_status s, const char *what)
+{
+    memcpy(w->state, backup, (size_t)w->count * 6 * sizeof(double));
+    w->time = time0;
+    w->contact_count = 0;
+    return lc_fail(w, s, "%s; the step was undone", what);
+}
+
+lc_status lc_world_step(lc_world *w, double dt)
+{
+    size_t bytes;
+    double *backup, *s0, *s1, *scratch, remaining, time0;
+    int *rows, nrows = 0, i, events = 0, stalls = 0, nrest = 0;
+    if (w == NULL) return LC_ERR_NULL;
+    if (!isfinite(dt)) return lc_fail(w, LC_ERR_NOT_FINITE, "dt is not finite (%g)", dt);
+    if (!(dt > 0.0) || dt > 1.0) return lc_fail(w, LC_ERR_OUT_OF_RANGE, "dt = %g is outside (0, 1] s", dt);
+    memset(&w->last, 0, sizeof w->last);
+    w->last.steps = 1;
+    w->step_dt = dt;
+    w->contact_count = 0;
+    time0 = w->time;
+    bytes = (size_t)(w->count > 0 ? w->count : 1) * 6 * sizeof(double);
+    backup = lc_buf_get(&w->b_backup, bytes);
+    s0 = lc_buf_get(&w->b_state0, bytes);
+    s1 = lc_buf_get(&w->b_state1, bytes);
+    scratch = lc_buf_get(&w->b_vec3, bytes);
+    rows = lc_buf_get(&w->b_rows, (size_t)(w->count > 0 ? w->count : 1) * sizeof(int));
+    if (!backup || !s0 || !s1 || !scratch || !rows) return lc_fail(w, LC_ERR_NO_MEMORY, "out of memory in step");
+    memcpy(backup, w->state, (size_t)w->count * 6 * sizeof(double));
+    for (i = 0; i < w->count; ++i)
+        if (!w->is_static[i]) rows[nrows++] = i;
+
+    remaining = dt;
+    while (remaining > 0.0) {
+        int np, nc = 0, best = -1, nimp, hits;
+        double tmin = remaining;
+        const int *pairs;
+        lc_crossing *cross;
+        lc_touch *rest;
+
+        double trial = remaining, wmax = 0.0;
+        nrest = gather_resting(w, w->state);
+        if (nrest < 0) goto oom;
+        rest = (lc_touch *)w->b_touch.p;
+        memcpy(s0, w->state, (size_t)w->count * 6 * sizeof(double));
+        /* Vertex paths are tested as straight lines in the other body's frame; that holds while bodies
+         * turn little, so a fast spinner is checked over shorter trial intervals. */
+        for (i = 0; i < nrows; ++i) wmax = fmax(wmax, fabs(s0[rows[i] * 6 + SW]));
+        if (wmax * trial > LC_MAX_TRIAL_ROTATION) trial = LC_MAX_TRIAL_ROTATION / wmax;
+        if (lc_integrate(w, s0, trial, rows, nrows, rest, nrest, s1) != 0) goto oom;
+        tmin = trial;
+
+        /* vertices that entered another body during the trial step */
+        np = lc_broad_phase(w, s0, s1, w->def.contact_distance, &w->b_pairs);
+        if (np < 0) goto oom;
+        pairs = (const int *)w->b_pairs.p;
+        for (i = 0; i < np && stalls < 2; ++i) {
+            nc = lc_find_crossings(w, s0, s1, pairs[2 * i], pairs[2 * i + 1], &w->b_cross, nc);
+            if (nc < 0) goto oom;
+        }
+        cross = (lc_crossing *)w->b_cross.p;
+
+        /* earliest time of impact; a crossing whose gap is still open at the best time so far is later */
+        for (i = 0; i < nc; ++i) {
+            double tau;
+            if (best >= 0) {
+                double g;
+                if (lc_integrate(w, s0, tmin, rows, nrows, rest, nrest, scratch) != 0) goto oom;
+                g = lc_vertex_edge_gap(w, scratch, cross[i].a, cross[i].vertex, cross[i].b, cross[i].edge);
+                if (g > w->def.contact_gap) continue;
+            }
+            tau = lc_time_of_impact(w, s0, tmin, &cross[i], rows, nrows, rest, nrest, scratch);
+            if (tau < 0.0) continue;
+            if (best < 0 || tau < tmin) { tmin = tau; best = i; }
+        }
+        if (best < 0) {
+            memcpy(w->state, s1, (size_t)w->count * 6 * sizeof(double));
+            remaining -= trial;
+            if (remaining < 1e-14 * dt) remaining = 0.0;
+            w->time = time0 + (dt - remaining);
+            continue;
+        }
+
+        if (tmin > 0.0) {
+            if (lc_integrate(w, s0, tmin, rows, nrows, rest, nrest, w->state) != 0) goto oom;
+        } else {
+            memcpy(w->state, s0, (size_t)w->count * 6 * sizeof(double));
+        }
+        remaining -= tmin;
+        w->time = time0 + (dt - remaining);
+        if (remaining < 1e-14 * dt) remaining = 0.0;
+
+        nimp = gather_impact(w, w->state, &cross[best]);
+        if (nimp < 0) goto oom;
+        hits = lc_resolve_impacts(w, w->state, (lc_touch *)w->b_impact.p, nimp);
+        if (hits < 0) goto oom;
+        {
+            lc_touch *t = (lc_touch *)w->b_impact.p;
+            for (i = 0; i < nimp; ++i)
+                if (t[i].value > 0.0) {
+                    w->last.impulses++;
+                    if (push_contact(w, &t[i], LC_CONTACT_COLLISION) != 0) goto oom;
+                }
+        }
+        w->last.collisions++;
+        events++;
+        /* no progress in time and nothing to push apart: let the contact solver take over next pass */
+        stalls = (hits == 0 && tmin == 0.0) ? stalls + 1 : 0;
+        if (events >= w->def.max_events_per_step) stalls = 2;
+    }
+    if (remaining == 0.0) w->time = time0 + dt;
+
+    /* resting contacts at the end of the step, with the forces of the last evaluation */
+    {
+        lc_touch *rest = (lc_touch *)w->b_touch.p;
+        for (i = 0; i < nrest; ++i) {
+            lc_touch t = rest[i];
+            lc_touch_update(w, w->state, &t);
+            if (push_contact(w, &t, LC_CONTACT_RESTING) != 0) goto oom;
+        }
+    }
+    for (i = 0; i < w->count * 6; ++i)
+        if (!isfinite(w->state[i])) return step_failed(w, backup, time0, LC_ERR_NUMERIC, "the state became non-finite");
+    add_counters(&w->total, &w->last);
+    w->error[0] = '\0';
+    return LC_OK;
+oom:
+    return step_failed(w, backup, time0, LC_ERR_NO_MEMORY, "out of memory during the step");
+}

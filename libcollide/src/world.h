@@ -1,0 +1,165 @@
+/* Internal layout of lc_world, shared by the engine's source files. Not installed. */
+#ifndef LC_WORLD_INTERNAL_H
+#define LC_WORLD_INTERNAL_H
+
+#include <stddef.h>
+#include "collide/collide.h"
+#include "lcp.h"
+
+#define LC_STATE_SIZE 6
+enum { SX = 0, SY = 1, SA = 2, SVX = 3, SVY = 4, SW = 5 };
+
+typedef struct lc_thruster {
+    lc_vec2 point;      /* body frame, relative to the centre of mass */
+    lc_vec2 direction;  /* body frame, unit */
+    double magnitude;
+    double level;
+} lc_thruster;
+
+/* Shape and material of one body; vertices are relative to the centre of mass. */
+typedef struct lc_shape {
+    int count;
+    lc_vec2 v[LC_MAX_POLYGON_VERTICES];
+    lc_vec2 n[LC_MAX_POLYGON_VERTICES];   /* outward unit normal of edge v[i] -> v[i+1] */
+    lc_vec2 center_offset;                /* local-frame origin -> centre of mass, body frame */
+    double radius;                        /* max |v[i]| */
+    double area;
+    double unit_inertia;                  /* moment about the centre of mass per unit mass, m^2 */
+} lc_shape;
+
+typedef struct lc_spring_rec {
+    lc_spring_id id;
+    lc_spring_def def;   /* body points stored as given (local-origin frame) */
+} lc_spring_rec;
+
+/* A vertex of body row a against edge `edge` of body row b: a touch (resting contact or impact point). */
+typedef struct lc_touch {
+    int a, b, vertex, edge;
+    double elasticity, friction;
+    lc_vec2 p, n, ra, rb;  /* world point, edge normal, offsets from the two centres of mass */
+    double gap, vn;
+    double value;          /* force (resting) or accumulated impulse (impact) */
+    double vn_pre;         /* normal velocity before the event (impacts) */
+    double target_vn;      /* impacts: normal velocity the point must reach or exceed */
+    double tangent;        /* accumulated friction impulse (impacts) */
+} lc_touch;
+
+typedef struct lc_buf {  /* growable scratch array */
+    void *p;
+    size_t cap;          /* bytes */
+} lc_buf;
+
+struct lc_world {
+    lc_world_def def;
+    double time;
+    char error[256];
+
+    /* bodies, dense rows in insertion order */
+    int count, capacity;
+    lc_body_id *ids;
+    double *state;          /* count x 6 */
+    double *mass, *inertia, *inv_mass, *inv_inertia;
+    uint8_t *is_static;
+    double *elasticity, *friction;
+    lc_vec2 *ext_force;
+    double *ext_torque;
+    lc_shape *shape;
+    lc_thruster (*thrusters)[LC_MAX_THRUSTERS];
+    int *thruster_count;
+
+    lc_body_id next_body_id;
+    int *id_to_row;          /* indexed by id, -1 = removed */
+    size_t id_map_cap;
+
+    lc_spring_rec *springs;
+    int spring_count, spring_cap;
+    lc_spring_id next_spring_id;
+
+    lc_contact *contacts;    /* results of the last step */
+    int contact_count, contact_cap;
+
+    lc_counters last, total;
+
+    /* scratch, reused between steps */
+    lc_lcp_workspace *lcp;
+    lc_buf b_state0, b_state1, b_backup, b_k[4], b_tmp, b_acc;
+    lc_buf b_touch, b_rest, b_pairs, b_aabb, b_rows, b_island, b_flags, b_mat, b_vec, b_vec2, b_vec3, b_order;
+    lc_buf b_cross, b_impact, b_irows;
+    double step_dt;          /* dt of the step in progress (stabilisation time scale) */
+};
+
+/* ---- scratch memory ---- */
+void *lc_buf_get(lc_buf *b, size_t bytes);   /* NULL on allocation failure */
+void lc_buf_free(lc_buf *b);
+
+/* ---- errors ---- */
+lc_status lc_fail(lc_world *w, lc_status s, const char *fmt, ...);
+
+/* ---- polygon.c ---- */
+lc_status lc_shape_build(lc_shape *out, const lc_vec2 *v, int count, char *why, size_t why_len);
+
+/* ---- small vector helpers ---- */
+static inline lc_vec2 lc_v(double x, double y) { lc_vec2 r; r.x = x; r.y = y; return r; }
+static inline lc_vec2 lc_add(lc_vec2 a, lc_vec2 b) { return lc_v(a.x + b.x, a.y + b.y); }
+static inline lc_vec2 lc_sub(lc_vec2 a, lc_vec2 b) { return lc_v(a.x - b.x, a.y - b.y); }
+static inline lc_vec2 lc_scale(lc_vec2 a, double s) { return lc_v(a.x * s, a.y * s); }
+static inline double lc_dot(lc_vec2 a, lc_vec2 b) { return a.x * b.x + a.y * b.y; }
+static inline double lc_cross(lc_vec2 a, lc_vec2 b) { return a.x * b.y - a.y * b.x; }
+/* omega x r for a scalar angular velocity */
+static inline lc_vec2 lc_wcross(double w, lc_vec2 r) { return lc_v(-w * r.y, w * r.x); }
+static inline lc_vec2 lc_rot(double c, double s, lc_vec2 a) { return lc_v(c * a.x - s * a.y, s * a.x + c * a.y); }
+static inline lc_vec2 lc_rot_inv(double c, double s, lc_vec2 a) { return lc_v(c * a.x + s * a.y, -s * a.x + c * a.y); }
+
+/* ---- forces.c: accelerations from applied (non-contact) forces ---- */
+/* For rows[0..n): acc[row*3 + 0..2] = (ax, ay, alpha) from gravity, damping, thrusters, springs, external. */
+void lc_applied_accelerations(const lc_world *w, const double *state, const int *rows, int n, double *acc);
+/* 1 if a body's applied forces are constant over time (so it may be advanced in closed form). */
+int lc_body_forces_constant(const lc_world *w, int row);
+
+/* ---- narrow_phase.c ---- */
+/* Geometry of a vertex/edge touch at `state`; fills p, n, ra, rb, gap, vn. */
+void lc_touch_update(const lc_world *w, const double *state, lc_touch *t);
+/* Appends touches between rows a and b with gap < max_gap (both directions), reduced to a manifold.
+ * Returns the new count or -1 on allocation failure. */
+int lc_collect_touches(const lc_world *w, const double *state, int a, int b, double max_gap,
+                       lc_buf *buf, int count);
+/* Crossing found between two states: vertex of row a entered edge of row b. */
+typedef struct lc_crossing { int a, b, vertex, edge; double toi; } lc_crossing;
+/* Appends crossings of the pair (a, b) between state0 and state1. Returns new count or -1. */
+int lc_find_crossings(const lc_world *w, const double *s0, const double *s1, int a, int b,
+                      lc_buf *buf, int count);
+/* Signed distance of vertex of a from the line of edge of b at state. */
+double lc_vertex_edge_gap(const lc_world *w, const double *state, int a, int vertex, int b, int edge);
+
+/* ---- broad_phase.c ---- */
+/* Candidate pairs (a < b by row, not both static) whose boxes, swept from s0 to s1 (s1 may equal s0) and
+ * grown by margin, overlap. Writes pairs as int[2] into buf; returns count or -1. */
+int lc_broad_phase(lc_world *w, const double *s0, const double *s1, double margin, lc_buf *buf);
+
+/* ---- contact_forces.c ---- */
+/* Adds resting contact forces for touches[0..n) into acc (rows indexed), solving the contact LCP.
+ * Stores each force in touches[i].value. Returns 0, or -1 on allocation failure. */
+int lc_contact_forces(lc_world *w, const double *state, lc_touch *touches, int n, double *acc);
+/* Builds the n x n matrix of normal responses (delta normal velocity at i per unit impulse at j). */
+void lc_response_matrix(const lc_world *w, const lc_touch *t, int n, double *A);
+
+/* ---- integrator.c ---- */
+/* Advances rows (dynamic bodies) from s0 by h into s1 with the world integrator, touches held as resting
+ * contacts. Rows not listed are copied unchanged only if copy_all. Returns 0 or -1. */
+int lc_integrate(lc_world *w, const double *s0, double h, const int *rows, int nrows,
+                 lc_touch *touches, int ntouches, double *s1);
+
+/* ---- impulse.c ---- */
+/* Resolves the impact among touches[0..n) at the current state (velocities changed in place).
+ * Returns number of points that received an impulse, or -1 on allocation failure. */
+int lc_resolve_impacts(lc_world *w, double *state, lc_touch *t, int n);
+
+/* ---- time_of_impact.c ---- */
+/* Time in [0, h] at which the crossing's gap reaches the contact gap; integrates the listed rows. */
+double lc_time_of_impact(lc_world *w, const double *s0, double h, const lc_crossing *c,
+                         const int *rows, int nrows, lc_touch *touches, int ntouches, double *scratch);
+
+/* ---- energy.c ---- */
+void lc_compute_energy(const lc_world *w, const double *state, lc_energy *out);
+
+#endif

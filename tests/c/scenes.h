@@ -1,0 +1,277 @@
+/* scenes.h - shared helpers that build and inspect test scenes for the libcollide C tests
+ * (header only, C99, all static inline). Include after check.h.
+ *
+ *   sc_world(def)                      - create a world (NULL def = defaults); failure is a failed CHECK
+ *   sc_def_zero_g()                    - default settings with gravity 0
+ *   sc_box(w, width, height, x, y, angle, vx, vy, omega, mass, e)  - add a dynamic w x h rectangle
+ *   sc_static_box(w, width, height, x, y, e)                      - add a static rectangle
+ *   sc_poly(w, verts, n, x, y, angle, mass)                        - add a dynamic polygon
+ *   sc_row(w, id)                      - pointer to a body's 6 state doubles (x, y, angle, vx, vy, omega)
+ *   sc_mass(w, id), sc_inertia(w, id)
+ *   sc_energy(w)                       - lc_energy of the current state
+ *   sc_kinetic(w), sc_momentum(w, &px, &py, &L)  - computed here from the state view (independent of
+ *                                        the engine's energy code); L is about the world origin
+ *   sc_separation(w, a, b)             - signed separation of two convex bodies (SAT): > 0 apart
+ *                                        (a lower bound of the distance, exact for vertex-edge
+ *                                        closest features), < 0 overlapping by that depth
+ *   sc_min_y(w, id), sc_max_x(w, id)   - extreme world vertex coordinates
+ *   sc_rng                              - small deterministic generator (no global state)
+ *   sc_step_n(w, dt, n)                - n steps; stops and fails a CHECK on the first non-OK status
+ */
+#ifndef LC_TESTS_SCENES_H
+#define LC_TESTS_SCENES_H
+
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "collide/collide.h"
+#include "check.h"
+
+#define SC_PI 3.14159265358979323846
+
+static inline lc_world *sc_world(const lc_world_def *def)
+{
+    char err[256];
+    lc_world_def d = def ? *def : lc_default_world_def();
+    lc_world *w;
+    err[0] = '\0';
+    w = lc_world_create(&d, err, sizeof err);
+    CHECK(w != NULL, "lc_world_create failed: %s", err);
+    return w;
+}
+
+static inline lc_world_def sc_def_zero_g(void)
+{
+    lc_world_def d = lc_default_world_def();
+    d.gravity.x = 0.0;
+    d.gravity.y = 0.0;
+    return d;
+}
+
+static inline lc_body_id sc_add(lc_world *w, const lc_body_def *bd, const char *what)
+{
+    lc_body_id id = 0;
+    lc_status s = lc_world_add_body(w, bd, &id);
+    CHECK(s == LC_OK, "add_body(%s) -> %s: %s", what, lc_status_string(s), lc_world_last_error(w));
+    return id;
+}
+
+static inline lc_body_id sc_box(lc_world *w, double width, double height, double x, double y, double angle,
+                                double vx, double vy, double omega, double mass, double e)
+{
+    lc_vec2 v[4];
+    lc_body_def bd = lc_default_body_def();
+    lc_status s = lc_make_rectangle(width, height, v);
+    CHECK(s == LC_OK, "lc_make_rectangle(%g, %g) -> %s", width, height, lc_status_string(s));
+    bd.vertices = v;
+    bd.vertex_count = 4;
+    bd.position.x = x;
+    bd.position.y = y;
+    bd.angle = angle;
+    bd.velocity.x = vx;
+    bd.velocity.y = vy;
+    bd.angular_velocity = omega;
+    bd.mass = mass;
+    bd.elasticity = e;
+    return sc_add(w, &bd, "box");
+}
+
+static inline lc_body_id sc_static_box(lc_world *w, double width, double height, double x, double y, double e)
+{
+    lc_vec2 v[4];
+    lc_body_def bd = lc_default_body_def();
+    lc_status s = lc_make_rectangle(width, height, v);
+    CHECK(s == LC_OK, "lc_make_rectangle(%g, %g) -> %s", width, height, lc_status_string(s));
+    bd.type = LC_BODY_STATIC;
+    bd.vertices = v;
+    bd.vertex_count = 4;
+    bd.position.x = x;
+    bd.position.y = y;
+    bd.elasticity = e;
+    return sc_add(w, &bd, "static box");
+}
+
+static inline lc_body_id sc_poly(lc_world *w, const lc_vec2 *verts, int n, double x, double y, double angle,
+                                 double mass)
+{
+    lc_body_def bd = lc_default_body_def();
+    bd.vertices = verts;
+    bd.vertex_count = n;
+    bd.position.x = x;
+    bd.position.y = y;
+    bd.angle = angle;
+    bd.mass = mass;
+    return sc_add(w, &bd, "polygon");
+}
+
+static inline const double *sc_row(const lc_world *w, lc_body_id id)
+{
+    static const double zeros[6] = {0, 0, 0, 0, 0, 0};
+    lc_state_view v;
+    int i = lc_world_body_index(w, id);
+    if (i < 0 || lc_world_get_state(w, &v) != LC_OK) {
+        CHECK(0, "body %u has no state row", (unsigned)id);
+        return zeros;
+    }
+    return v.state + 6 * i;
+}
+
+static inline double sc_mass(const lc_world *w, lc_body_id id)
+{
+    lc_state_view v;
+    int i = lc_world_body_index(w, id);
+    if (i < 0 || lc_world_get_state(w, &v) != LC_OK) return NAN;
+    return v.mass[i];
+}
+
+static inline double sc_inertia(const lc_world *w, lc_body_id id)
+{
+    lc_state_view v;
+    int i = lc_world_body_index(w, id);
+    if (i < 0 || lc_world_get_state(w, &v) != LC_OK) return NAN;
+    return v.inertia[i];
+}
+
+static inline lc_energy sc_energy(const lc_world *w)
+{
+    lc_energy e;
+    memset(&e, 0, sizeof e);
+    CHECK(lc_world_get_energy(w, &e) == LC_OK, "%s", "lc_world_get_energy");
+    return e;
+}
+
+/* Kinetic energy (J) from the state view: sum m|v|^2/2 + I w^2/2 over dynamic bodies. */
+static inline double sc_kinetic(const lc_world *w)
+{
+    lc_state_view v;
+    double k = 0.0;
+    int i;
+    if (lc_world_get_state(w, &v) != LC_OK) return NAN;
+    for (i = 0; i < v.count; i++) {
+        const double *s = v.state + 6 * i;
+        if (v.is_static[i]) continue;
+        k += 0.5 * v.mass[i] * (s[3] * s[3] + s[4] * s[4]) + 0.5 * v.inertia[i] * s[5] * s[5];
+    }
+    return k;
+}
+
+/* Linear momentum (kg m/s) and angular momentum about the world origin (kg m^2/s). */
+static inline void sc_momentum(const lc_world *w, double *px, double *py, double *L)
+{
+    lc_state_view v;
+    int i;
+    *px = *py = *L = 0.0;
+    if (lc_world_get_state(w, &v) != LC_OK) return;
+    for (i = 0; i < v.count; i++) {
+        const double *s = v.state + 6 * i;
+        if (v.is_static[i]) continue;
+        *px += v.mass[i] * s[3];
+        *py += v.mass[i] * s[4];
+        *L += v.mass[i] * (s[0] * s[4] - s[1] * s[3]) + v.inertia[i] * s[5];
+    }
+}
+
+/* World vertices of a body into out[LC_MAX_POLYGON_VERTICES]; returns the count (0 on error). */
+static inline int sc_world_vertices(const lc_world *w, lc_body_id id, lc_vec2 *out)
+{
+    int n = lc_body_vertex_count(w, id);
+    if (n < 3 || n > LC_MAX_POLYGON_VERTICES) return 0;
+    if (lc_body_get_world_vertices(w, id, out, n) != LC_OK) return 0;
+    return n;
+}
+
+/* max over the edges of P of min over the vertices of Q of the signed distance along the edge's
+ * outward normal. */
+static inline double sc_sat_one_way_(const lc_vec2 *p, int np, const lc_vec2 *q, int nq)
+{
+    double area2 = 0.0, best = -INFINITY;
+    int i, j;
+    for (i = 0; i < np; i++) {
+        const lc_vec2 a = p[i], b = p[(i + 1) % np];
+        area2 += a.x * b.y - b.x * a.y;
+    }
+    for (i = 0; i < np; i++) {
+        const lc_vec2 a = p[i], b = p[(i + 1) % np];
+        double ex = b.x - a.x, ey = b.y - a.y, len = sqrt(ex * ex + ey * ey), nx, ny, m = INFINITY;
+        /* outward normal: right of the edge for counter-clockwise polygons */
+        nx = ey / len;
+        ny = -ex / len;
+        if (area2 < 0) { nx = -nx; ny = -ny; }
+        for (j = 0; j < nq; j++) {
+            double d = (q[j].x - a.x) * nx + (q[j].y - a.y) * ny;
+            if (d < m) m = d;
+        }
+        if (m > best) best = m;
+    }
+    return best;
+}
+
+static inline double sc_separation(const lc_world *w, lc_body_id a, lc_body_id b)
+{
+    lc_vec2 pa[LC_MAX_POLYGON_VERTICES], pb[LC_MAX_POLYGON_VERTICES];
+    int na = sc_world_vertices(w, a, pa), nb = sc_world_vertices(w, b, pb);
+    double s1, s2;
+    if (!na || !nb) return NAN;
+    s1 = sc_sat_one_way_(pa, na, pb, nb);
+    s2 = sc_sat_one_way_(pb, nb, pa, na);
+    return s1 > s2 ? s1 : s2;
+}
+
+static inline double sc_min_y(const lc_world *w, lc_body_id id)
+{
+    lc_vec2 p[LC_MAX_POLYGON_VERTICES];
+    int n = sc_world_vertices(w, id, p), i;
+    double m = INFINITY;
+    if (!n) return NAN;
+    for (i = 0; i < n; i++) if (p[i].y < m) m = p[i].y;
+    return m;
+}
+
+static inline double sc_max_x(const lc_world *w, lc_body_id id)
+{
+    lc_vec2 p[LC_MAX_POLYGON_VERTICES];
+    int n = sc_world_vertices(w, id, p), i;
+    double m = -INFINITY;
+    if (!n) return NAN;
+    for (i = 0; i < n; i++) if (p[i].x > m) m = p[i].x;
+    return m;
+}
+
+/* Deterministic generator (64-bit LCG, Knuth's MMIX constants); state lives in the caller. */
+typedef struct sc_rng { uint64_t s; } sc_rng;
+
+static inline double sc_rand(sc_rng *r) /* uniform in [0, 1) */
+{
+    r->s = r->s * 6364136223846793005ULL + 1442695040888963407ULL;
+    return (double)(r->s >> 11) * (1.0 / 9007199254740992.0);
+}
+
+static inline double sc_uniform(sc_rng *r, double lo, double hi) { return lo + (hi - lo) * sc_rand(r); }
+
+/* n steps of dt; returns the number of steps done (stops at the first failure, which is a failed CHECK). */
+static inline int sc_step_n(lc_world *w, double dt, int n)
+{
+    int i;
+    for (i = 0; i < n; i++) {
+        lc_status s = lc_world_step(w, dt);
+        if (s != LC_OK) {
+            CHECK(0, "lc_world_step(%g) at t=%.9g -> %s: %s", dt, lc_world_get_time(w), lc_status_string(s),
+                  lc_world_last_error(w));
+            return i;
+        }
+    }
+    return n;
+}
+
+/* Sum of a counter field over the collision contacts of the last step, and their count. */
+static inline int sc_contacts(const lc_world *w, const lc_contact **out)
+{
+    int n = 0;
+    *out = NULL;
+    if (lc_world_get_contacts(w, out, &n) != LC_OK) return 0;
+    return n;
+}
+
+#endif /* LC_TESTS_SCENES_H */
