@@ -4,8 +4,9 @@
 #include <string.h>
 #include "world.h"
 
-/* Delta normal velocity (or acceleration) at touch i per unit normal impulse (or force) at touch j. */
-static double response(const lc_world *w, const lc_touch *ti, const lc_touch *tj)
+/* Delta relative velocity along di at touch i per unit impulse along dj at touch j (or acceleration
+ * per unit force): the J M^-1 J^T entry of the two rows. */
+static double response_dir(const lc_world *w, const lc_touch *ti, lc_vec2 di, const lc_touch *tj, lc_vec2 dj)
 {
     double sum = 0.0;
     int bodies_i[2], bodies_j[2], x, y;
@@ -20,12 +21,19 @@ static double response(const lc_world *w, const lc_touch *ti, const lc_touch *tj
             double sj = y == 0 ? 1.0 : -1.0;
             lc_vec2 rj = y == 0 ? tj->ra : tj->rb;
             if (bodies_j[y] != body) continue;
-            sum += si * sj * (lc_dot(ti->n, tj->n) * w->inv_mass[body] +
-                              lc_cross(ri, ti->n) * lc_cross(rj, tj->n) * w->inv_inertia[body]);
+            sum += si * sj * (lc_dot(di, dj) * w->inv_mass[body] +
+                              lc_cross(ri, di) * lc_cross(rj, dj) * w->inv_inertia[body]);
         }
     }
     return sum;
 }
+
+static double response(const lc_world *w, const lc_touch *ti, const lc_touch *tj)
+{
+    return response_dir(w, ti, ti->n, tj, tj->n);
+}
+
+static lc_vec2 tangent_of(lc_vec2 n) { return lc_v(-n.y, n.x); }
 
 void lc_response_matrix(const lc_world *w, const lc_touch *t, int n, double *A)
 {
@@ -48,8 +56,11 @@ static int find(int *parent, int x)
     return x;
 }
 
-/* Relative normal acceleration at a touch from the current (non-contact) accelerations. */
-static double free_normal_acceleration(const lc_world *w, const double *state, const lc_touch *t, const double *acc)
+/* Relative acceleration along dir at a touch from the current (non-contact) accelerations:
+ * dir.(a_pA - a_pB) + 2 (omega_B x dir).(v_pA - v_pB); the second term is the edge turning with
+ * body B (and, for the tangent, the contact point sliding along it). */
+static double free_acceleration(const lc_world *w, const double *state, const lc_touch *t, const double *acc,
+                                lc_vec2 dir)
 {
     const double *sa = &state[t->a * 6], *sb = &state[t->b * 6];
     const double *aa = &acc[t->a * 3], *ab = &acc[t->b * 3];
@@ -61,8 +72,76 @@ static double free_normal_acceleration(const lc_world *w, const double *state, c
         acc_b = lc_sub(lc_add(lc_v(ab[0], ab[1]), lc_wcross(ab[2], t->rb)), lc_scale(t->rb, wb * wb));
     va = lc_add(lc_v(sa[SVX], sa[SVY]), lc_wcross(wa, t->ra));
     vb = lc_add(lc_v(sb[SVX], sb[SVY]), lc_wcross(wb, t->rb));
-    /* d'' = n.(a_pA - a_pB) + 2 (omega_B x n).(v_pA - v_pB): the edge's normal turns with body B */
-    return lc_dot(t->n, lc_sub(acc_a, acc_b)) + 2.0 * lc_dot(lc_wcross(wb, t->n), lc_sub(va, vb));
+    return lc_dot(dir, lc_sub(acc_a, acc_b)) + 2.0 * lc_dot(lc_wcross(wb, dir), lc_sub(va, vb));
+}
+
+static double tangential_velocity(const double *state, const lc_touch *t)
+{
+    const double *sa = &state[t->a * 6], *sb = &state[t->b * 6];
+    lc_vec2 va = lc_add(lc_v(sa[SVX], sa[SVY]), lc_wcross(sa[SW], t->ra));
+    lc_vec2 vb = lc_add(lc_v(sb[SVX], sb[SVY]), lc_wcross(sb[SW], t->rb));
+    return lc_dot(tangent_of(t->n), lc_sub(va, vb));
+}
+
+static void apply_force(const lc_world *w, const lc_touch *t, lc_vec2 F, double *acc)
+{
+    if (!w->is_static[t->a]) {
+        acc[t->a * 3 + 0] += F.x * w->inv_mass[t->a];
+        acc[t->a * 3 + 1] += F.y * w->inv_mass[t->a];
+        acc[t->a * 3 + 2] += lc_cross(t->ra, F) * w->inv_inertia[t->a];
+    }
+    if (!w->is_static[t->b]) {
+        acc[t->b * 3 + 0] -= F.x * w->inv_mass[t->b];
+        acc[t->b * 3 + 1] -= F.y * w->inv_mass[t->b];
+        acc[t->b * 3 + 2] -= lc_cross(t->rb, F) * w->inv_inertia[t->b];
+    }
+}
+
+/* Normal and Coulomb friction forces for a group with friction: rows 0..m-1 normal (f >= 0), rows
+ * m..2m-1 tangent with |f_t| <= mu f_n, the tangent target being to stop sliding within h. */
+static int solve_with_friction(lc_world *w, const double *state, lc_touch *sub, int m, double *acc,
+                               double kv, double kd, double h, const lc_lcp_options *opt)
+{
+    int n2 = 2 * m, i, j;
+    double *A = lc_buf_get(&w->b_mat, (size_t)n2 * (size_t)n2 * sizeof(double));
+    double *b = lc_buf_get(&w->b_vec, (size_t)n2 * 4 * sizeof(double));
+    int *coupled = lc_buf_get(&w->b_order, (size_t)n2 * sizeof(int));
+    double *f, *mu;
+    lc_lcp_result res;
+    if (!A || !b || !coupled) return -1;
+    f = b + n2;
+    mu = f + n2;
+    for (i = 0; i < n2; ++i) {
+        const lc_touch *ti = &sub[i % m];
+        lc_vec2 di = i < m ? ti->n : tangent_of(ti->n);
+        for (j = 0; j < n2; ++j) {
+            const lc_touch *tj = &sub[j % m];
+            A[i * n2 + j] = response_dir(w, ti, di, tj, j < m ? tj->n : tangent_of(tj->n));
+        }
+        if (i < m) {
+            b[i] = free_acceleration(w, state, ti, acc, ti->n) + kv * ti->vn + kd * (ti->gap - w->def.contact_gap);
+            coupled[i] = -1;
+            mu[i] = 0.0;
+        } else {
+            b[i] = free_acceleration(w, state, ti, acc, tangent_of(ti->n)) + tangential_velocity(state, ti) / h;
+            coupled[i] = i - m;
+            mu[i] = ti->friction;
+        }
+        f[i] = 0.0;
+    }
+    lc_lcp_solve_boxed(n2, A, b, NULL, NULL, coupled, mu, f, NULL, opt, w->lcp, &res);
+    w->last.contact_solves++;
+    w->last.contact_solve_iterations += (uint64_t)res.iterations;
+    w->last.resting_contacts += (uint64_t)m;
+    if (res.residual > w->last.max_lcp_residual) w->last.max_lcp_residual = res.residual;
+    for (i = 0; i < m; ++i) {
+        double fn = f[i] > 0.0 && isfinite(f[i]) ? f[i] : 0.0;
+        double ft = isfinite(f[m + i]) ? f[m + i] : 0.0;
+        sub[i].value = fn;
+        sub[i].tangent = ft;
+        apply_force(w, &sub[i], lc_add(lc_scale(sub[i].n, fn), lc_scale(tangent_of(sub[i].n), ft)), acc);
+    }
+    return 0;
 }
 
 int lc_contact_forces(lc_world *w, const double *state, lc_touch *touches, int n, double *acc)
@@ -118,9 +197,22 @@ int lc_contact_forces(lc_world *w, const double *state, lc_touch *touches, int n
         f = lc_buf_get(&w->b_vec2, (size_t)m * sizeof(double));
         if (!sub || !A || !b || !f) return -1;
         for (j = 0; j < m; ++j) sub[j] = touches[order[g0 + j]];
+        {
+            int with_friction = 0;
+            for (j = 0; j < m; ++j) if (sub[j].friction > 0.0) with_friction = 1;
+            if (with_friction) {
+                if (solve_with_friction(w, state, sub, m, acc, kv, kd, h, &opt) != 0) return -1;
+                for (j = 0; j < m; ++j) {
+                    touches[order[g0 + j]].value = sub[j].value;
+                    touches[order[g0 + j]].tangent = sub[j].tangent;
+                }
+                g0 = g1;
+                continue;
+            }
+        }
         lc_response_matrix(w, sub, m, A);
         for (j = 0; j < m; ++j) {
-            b[j] = free_normal_acceleration(w, state, &sub[j], acc) + kv * sub[j].vn +
+            b[j] = free_acceleration(w, state, &sub[j], acc, sub[j].n) + kv * sub[j].vn +
                    kd * (sub[j].gap - w->def.contact_gap);
             f[j] = 0.0;
         }
@@ -132,18 +224,9 @@ int lc_contact_forces(lc_world *w, const double *state, lc_touch *touches, int n
         for (j = 0; j < m; ++j) {
             lc_touch *t = &touches[order[g0 + j]];
             double fj = f[j] > 0.0 && isfinite(f[j]) ? f[j] : 0.0;
-            lc_vec2 F = lc_scale(t->n, fj);
             t->value = fj;
-            if (!w->is_static[t->a]) {
-                acc[t->a * 3 + 0] += F.x * w->inv_mass[t->a];
-                acc[t->a * 3 + 1] += F.y * w->inv_mass[t->a];
-                acc[t->a * 3 + 2] += lc_cross(t->ra, F) * w->inv_inertia[t->a];
-            }
-            if (!w->is_static[t->b]) {
-                acc[t->b * 3 + 0] -= F.x * w->inv_mass[t->b];
-                acc[t->b * 3 + 1] -= F.y * w->inv_mass[t->b];
-                acc[t->b * 3 + 2] -= lc_cross(t->rb, F) * w->inv_inertia[t->b];
-            }
+            t->tangent = 0.0;
+            apply_force(w, t, lc_scale(t->n, fj), acc);
         }
         g0 = g1;
     }

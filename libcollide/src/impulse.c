@@ -29,24 +29,77 @@ static void apply_impulse(const lc_world *w, double *state, const lc_touch *t, l
     }
 }
 
-/* Coulomb friction for one point after its normal impulse jn: stop the sliding if the cone allows. */
-static void apply_friction(const lc_world *w, double *state, lc_touch *t, double jn)
+static lc_vec2 tangent_of(lc_vec2 n) { return lc_v(-n.y, n.x); }
+
+/* The response of a velocity along di at touch i to a unit impulse along dj at touch j. */
+static double response_dir(const lc_world *w, const lc_touch *ti, lc_vec2 di, const lc_touch *tj, lc_vec2 dj)
 {
-    const double *sa = &state[t->a * 6], *sb = &state[t->b * 6];
-    lc_vec2 tan = lc_v(-t->n.y, t->n.x), va, vb;
-    double vt, k = 0.0, jt, lim = t->friction * jn;
-    if (!(lim > 0.0)) return;
-    va = lc_add(lc_v(sa[SVX], sa[SVY]), lc_wcross(sa[SW], t->ra));
-    vb = lc_add(lc_v(sb[SVX], sb[SVY]), lc_wcross(sb[SW], t->rb));
-    vt = lc_dot(tan, lc_sub(va, vb));
-    if (!w->is_static[t->a]) k += w->inv_mass[t->a] + lc_cross(t->ra, tan) * lc_cross(t->ra, tan) * w->inv_inertia[t->a];
-    if (!w->is_static[t->b]) k += w->inv_mass[t->b] + lc_cross(t->rb, tan) * lc_cross(t->rb, tan) * w->inv_inertia[t->b];
-    if (!(k > 0.0)) return;
-    jt = -vt / k;
-    if (jt > lim) jt = lim;
-    if (jt < -lim) jt = -lim;
-    t->tangent += jt;
-    apply_impulse(w, state, t, lc_scale(tan, jt));
+    double sum = 0.0;
+    int bi[2], bj[2], x, y;
+    bi[0] = ti->a; bi[1] = ti->b;
+    bj[0] = tj->a; bj[1] = tj->b;
+    for (x = 0; x < 2; ++x) {
+        lc_vec2 ri = x == 0 ? ti->ra : ti->rb;
+        if (w->is_static[bi[x]]) continue;
+        for (y = 0; y < 2; ++y) {
+            lc_vec2 rj = y == 0 ? tj->ra : tj->rb;
+            if (bj[y] != bi[x]) continue;
+            sum += (x == y ? 1.0 : -1.0) * (lc_dot(di, dj) * w->inv_mass[bi[x]] +
+                                            lc_cross(ri, di) * lc_cross(rj, dj) * w->inv_inertia[bi[x]]);
+        }
+    }
+    return sum;
+}
+
+/* Impacts with Coulomb friction: normal rows a = A j + b >= 0 as without friction, tangent rows aim
+ * to stop the sliding, bounded by |j_t| <= mu j_n (boxed complementarity, projected Gauss-Seidel). */
+static int solve_block_friction(lc_world *w, double *state, lc_touch *t, int n, const double *bn,
+                                const lc_lcp_options *opt)
+{
+    int n2 = 2 * n, i, k, hits = 0;
+    double *A = lc_buf_get(&w->b_mat, (size_t)n2 * (size_t)n2 * sizeof(double));
+    double *b = lc_buf_get(&w->b_vec3, (size_t)n2 * 3 * sizeof(double));
+    int *coupled = lc_buf_get(&w->b_order, (size_t)n2 * sizeof(int));
+    double *j, *mu;
+    lc_lcp_options o = *opt;
+    lc_lcp_result res;
+    if (!A || !b || !coupled) return -1;
+    j = b + n2;
+    mu = j + n2;
+    o.max_iterations = o.max_iterations > 1000 ? o.max_iterations : 1000;
+    for (i = 0; i < n2; ++i) {
+        const lc_touch *ti = &t[i % n];
+        lc_vec2 di = i < n ? ti->n : tangent_of(ti->n);
+        for (k = 0; k < n2; ++k) {
+            const lc_touch *tk = &t[k % n];
+            A[i * n2 + k] = response_dir(w, ti, di, tk, k < n ? tk->n : tangent_of(tk->n));
+        }
+        if (i < n) {
+            b[i] = bn[i];
+            coupled[i] = -1;
+            mu[i] = 0.0;
+        } else {
+            const double *sa = &state[ti->a * 6], *sb = &state[ti->b * 6];
+            lc_vec2 va = lc_add(lc_v(sa[SVX], sa[SVY]), lc_wcross(sa[SW], ti->ra));
+            lc_vec2 vb = lc_add(lc_v(sb[SVX], sb[SVY]), lc_wcross(sb[SW], ti->rb));
+            b[i] = lc_dot(di, lc_sub(va, vb));
+            coupled[i] = i - n;
+            mu[i] = ti->friction;
+        }
+        j[i] = 0.0;
+    }
+    lc_lcp_solve_boxed(n2, A, b, NULL, NULL, coupled, mu, j, NULL, &o, w->lcp, &res);
+    w->last.impulse_solves++;
+    for (i = 0; i < n; ++i) {
+        double jn = j[i] > 0.0 && isfinite(j[i]) ? j[i] : 0.0;
+        double jt = isfinite(j[n + i]) ? j[n + i] : 0.0;
+        if (jn <= 0.0) continue;
+        apply_impulse(w, state, &t[i], lc_add(lc_scale(t[i].n, jn), lc_scale(tangent_of(t[i].n), jt)));
+        t[i].value += jn;
+        t[i].tangent += jt;
+        hits++;
+    }
+    return hits;
 }
 
 /* Solves the impulse problem for touches t[0..n) with per-point restitution (use_e) and applies it.
@@ -74,6 +127,11 @@ static int solve_block(lc_world *w, double *state, lc_touch *t, int n, int use_e
         b[i] = vn + e * (vn < 0.0 ? vn : 0.0);
         j[i] = 0.0;
     }
+    {
+        int with_friction = 0;
+        for (i = 0; i < n; ++i) if (t[i].friction > 0.0) with_friction = 1;
+        if (with_friction) return solve_block_friction(w, state, t, n, b, &opt);
+    }
     if (n == 1) {
         /* eq. 11 directly: j = -(1 + e) v_n / (1/m_a + 1/m_b + (r_a x n)^2/I_a + (r_b x n)^2/I_b) */
         j[0] = b[0] < 0.0 && A[0] > 0.0 ? -b[0] / A[0] : 0.0;
@@ -89,8 +147,6 @@ static int solve_block(lc_world *w, double *state, lc_touch *t, int n, int use_e
         t[i].value += ji;
         hits++;
     }
-    for (i = 0; i < n; ++i)
-        if (j[i] > 0.0 && isfinite(j[i])) apply_friction(w, state, &t[i], j[i]);
     return hits;
 }
 

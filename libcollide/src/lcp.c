@@ -492,7 +492,8 @@ static int exact_solve(int n, const double *A, const double *b, double *f, doubl
             if (j < 0) {
                 /* No blocking index: f_d can grow forever. If row d depends on the active rows
                  * (da_d ~ 0) and a_d < 0 only by rounding (|a_d| <= noise), leave f_d = 0 and mark d
-                 * dependent (never driven again; the final residual check still judges it).
+                 * dependent (not driven again until the active set changes; the final residual
+                 * check still judges it).
                  * Otherwise the problem is infeasible (or numerically stuck): give up. */
                 if (!(da[d] > tda) && -a[d] <= noise) {
                     st[d] = ST_DEP;
@@ -607,13 +608,12 @@ int lc_lcp_solve(int n, const double *A, const double *b, double *f, double *a_o
     if (use_exact) {
         /* rounding-level negative accelerations of dependent rows are tolerated up to a tenth of
          * the requested residual */
-        int er = exact_solve(n, A, b, fx, a, o.regularization, 0.1 * o.tolerance * bscale, ws->d, ws->i,
-                             &pivots);
-        double rex = raw_residual(n, fx, a, &bd) / bscale;
+        double rex;
+        (void)exact_solve(n, A, b, fx, a, o.regularization, 0.1 * o.tolerance * bscale, ws->d, ws->i, &pivots);
+        rex = raw_residual(n, fx, a, &bd) / bscale;
         exact_used = 1;
         /* the exact answer is accepted whenever its true residual meets the tolerance (also after
          * a cap / no-blocking exit, which can happen on rounding-level degeneracy) */
-        (void)er;
         if (rex <= o.tolerance) {
             memcpy(f, fx, nn * sizeof(double));
             r = rex;

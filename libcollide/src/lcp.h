@@ -12,9 +12,12 @@
  *   (dependent rows skipped, negative forces dropped), the active block is factorised by a
  *   Cholesky factor updated in O(k^2) per pivot (add/delete row), and a pivot whose Schur
  *   complement is ~0 gets the relative diagonal regularisation opt.regularization * A_jj.
- *   Pivot cap 10 n + 50. If the cap is hit, the problem is found infeasible/numerically stuck, or
- *   the exact answer misses opt.tolerance, projected Gauss-Seidel is run warm-started from the
- *   exact iterate and the better of the two answers is returned (result.exact says which).
+ *   A row whose driving direction is ~0 (it depends on the active rows) and whose a_d < 0 only by
+ *   rounding (|a_d| <= 0.1 * tolerance * max|b|) is left at f_d = 0. Pivot cap 10 n + 50.
+ *   The exact answer (clamped to f >= 0, a recomputed) is accepted when its residual is <=
+ *   opt.tolerance. Otherwise (cap hit, infeasible / numerically stuck, or rounding above the
+ *   tolerance) projected Gauss-Seidel is run warm-started from the exact iterate and the better of
+ *   the two answers is returned (result.exact says which, result.fallback = 1).
  * - Iterative (n > opt.exact_max, and the boxed variant): projected Gauss-Seidel / SOR in fixed
  *   index order, f_i <- clamp(f_i - w a_i / A_ii, lo_i, hi_i), keeping a = A f + b up to date
  *   (recomputed exactly every 32 sweeps and before any decision to stop).

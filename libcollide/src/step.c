@@ -22,12 +22,33 @@ static int gather_touches(lc_world *w, const double *state, lc_buf *buf)
     return n;
 }
 
-/* Resting set: touching points that neither approach nor separate faster than resting_speed. */
-static int gather_resting(lc_world *w, const double *state)
+static int push_contact(lc_world *w, const lc_touch *t, lc_contact_kind kind);
+
+/* Resting set: touching points that neither approach nor separate faster than resting_speed.
+ * Touches already inside the contact gap that still approach faster than that are impacts that no
+ * crossing test can see any more (they start inside); they are resolved here, before the step. */
+static int gather_resting(lc_world *w, double *state, int *impacts)
 {
-    int n = gather_touches(w, state, &w->b_touch), i, k = 0;
+    int n = gather_touches(w, state, &w->b_touch), i, k = 0, urgent = 0;
     lc_touch *t = (lc_touch *)w->b_touch.p;
     if (n < 0) return -1;
+    for (i = 0; i < n; ++i)
+        if (t[i].gap <= w->def.contact_gap && t[i].vn < -w->def.resting_speed) urgent = 1;
+    if (urgent) {
+        lc_touch *x = lc_buf_get(&w->b_impact, (size_t)n * sizeof(lc_touch));
+        if (x == NULL) return -1;
+        memcpy(x, t, (size_t)n * sizeof(lc_touch));
+        if (lc_resolve_impacts(w, state, x, n) < 0) return -1;
+        for (i = 0; i < n; ++i) {
+            if (x[i].value > 0.0) {
+                w->last.impulses++;
+                if (push_contact(w, &x[i], LC_CONTACT_COLLISION) != 0) return -1;
+            }
+            lc_touch_update(w, state, &t[i]);
+        }
+        w->last.collisions++;
+        ++*impacts;
+    }
     for (i = 0; i < n; ++i)
         if (fabs(t[i].vn) <= w->def.resting_speed) t[k++] = t[i];
     return k;
@@ -182,7 +203,7 @@ lc_status lc_world_step(lc_world *w, double dt)
         lc_touch *rest;
 
         double trial = remaining, wmax = 0.0;
-        nrest = gather_resting(w, w->state);
+        nrest = gather_resting(w, w->state, &events);
         if (nrest < 0) goto oom;
         rest = (lc_touch *)w->b_touch.p;
         memcpy(s0, w->state, (size_t)w->count * 6 * sizeof(double));

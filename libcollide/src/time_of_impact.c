@@ -4,15 +4,16 @@
 #include <math.h>
 #include "world.h"
 
+/* Gap of the crossing's vertex at time tau after s0, minus the target gap. */
 static double gap_at(lc_world *w, const double *s0, double tau, const lc_crossing *c, const int *rows,
-                     int nrows, lc_touch *touches, int nt, double *scratch)
+                     int nrows, lc_touch *touches, int nt, double *scratch, double target)
 {
     if (tau > 0.0) {
         if (lc_integrate(w, s0, tau, rows, nrows, touches, nt, scratch) != 0) return NAN;
         w->last.toi_iterations++;
-        return lc_vertex_edge_gap(w, scratch, c->a, c->vertex, c->b, c->edge) - w->def.contact_gap;
+        return lc_vertex_edge_gap(w, scratch, c->a, c->vertex, c->b, c->edge) - target;
     }
-    return lc_vertex_edge_gap(w, s0, c->a, c->vertex, c->b, c->edge) - w->def.contact_gap;
+    return lc_vertex_edge_gap(w, s0, c->a, c->vertex, c->b, c->edge) - target;
 }
 
 /* d/dt of the gap at s0: the relative normal velocity of the vertex against the edge. */
@@ -31,11 +32,11 @@ double lc_time_of_impact(lc_world *w, const double *s0, double h, const lc_cross
                          const int *rows, int nrows, lc_touch *touches, int nt, double *scratch)
 {
     const lc_world_def *d = &w->def;
-    double a = 0.0, b = h, fa, fb, m = 0.0, fm;
+    double a = 0.0, b = h, fa, fb, m = 0.0, fm, target = d->contact_gap;
     int it, side = 0;
     double va;
     w->last.toi_searches++;
-    fa = gap_at(w, s0, 0.0, c, rows, nrows, touches, nt, scratch);
+    fa = gap_at(w, s0, 0.0, c, rows, nrows, touches, nt, scratch, target);
     va = gap_rate(w, s0, c);
     if (!(fa > d->toi_distance_tolerance)) {
         /* already within the contact gap: approaching is an impact now; hardly moving is a resting
@@ -43,20 +44,30 @@ double lc_time_of_impact(lc_world *w, const double *s0, double h, const lc_cross
         if (va < -d->resting_speed) return 0.0;
         if (!(va > 0.0)) return -1.0;
     }
-    fb = gap_at(w, s0, h, c, rows, nrows, touches, nt, scratch);
+    fb = gap_at(w, s0, h, c, rows, nrows, touches, nt, scratch, target);
     if (!isfinite(fb)) return -1.0;
     if (!(fa > d->toi_distance_tolerance)) {
         /* The vertex is leaving the gap (it just bounced) and comes back within the step: g has a root
          * at 0 and the one we want later. Start the bracket at the apex of the parabola through
          * g(0), g'(0) and g(h), where the gap is open. */
-        double acc = 2.0 * (fb - fa - va * h) / (h * h);
+        double acc;
+        /* A weak bounce from inside the gap band may never rise to contact_gap: then the impact is
+         * where the vertex comes back to the gap it left from. */
+        double start_gap = fa + target;
+        if (start_gap - d->toi_distance_tolerance < target) {
+            target = start_gap - d->toi_distance_tolerance;
+            fa = d->toi_distance_tolerance;
+            fb = gap_at(w, s0, h, c, rows, nrows, touches, nt, scratch, target);
+            if (!isfinite(fb)) return -1.0;
+        }
+        acc = 2.0 * (fb - fa - va * h) / (h * h);
         double apex = acc < 0.0 ? -va / acc : 0.5 * h;
         int k;
         if (!(apex < h)) apex = 0.5 * h;
         for (k = 0; k < 30; ++k, apex *= 0.5) {
-            double fx = gap_at(w, s0, apex, c, rows, nrows, touches, nt, scratch);
+            double fx = gap_at(w, s0, apex, c, rows, nrows, touches, nt, scratch, target);
             if (!isfinite(fx)) return -1.0;
-            if (fx > d->toi_distance_tolerance) { a = apex; fa = fx; break; }
+            if (fx > fa) { a = apex; fa = fx; break; }
         }
         if (k == 30) return 0.0;                  /* never opens: treat as touching now */
     }
@@ -65,7 +76,7 @@ double lc_time_of_impact(lc_world *w, const double *s0, double h, const lc_cross
         int k;
         for (k = 1; k < 8 && fb > 0.0; ++k) {
             b = a + (h - a) * k / 8.0;
-            fb = gap_at(w, s0, b, c, rows, nrows, touches, nt, scratch);
+            fb = gap_at(w, s0, b, c, rows, nrows, touches, nt, scratch, target);
         }
         if (!(fb <= 0.0)) return -1.0;            /* no impact in this step */
     }
@@ -77,7 +88,7 @@ double lc_time_of_impact(lc_world *w, const double *s0, double h, const lc_cross
             m = (a * fb - b * fa) / (fb - fa);
             if (!(m > a && m < b)) m = 0.5 * (a + b);
         }
-        fm = gap_at(w, s0, m, c, rows, nrows, touches, nt, scratch);
+        fm = gap_at(w, s0, m, c, rows, nrows, touches, nt, scratch, target);
         if (!isfinite(fm)) return -1.0;
         if (fabs(fm) <= d->toi_distance_tolerance && d->toi_method == LC_TOI_ROOT_FINDER) return m;
         if (fm > 0.0) {

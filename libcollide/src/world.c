@@ -332,6 +332,7 @@ lc_status lc_world_add_body(lc_world *w, const lc_body_def *d, lc_body_id *out_i
     lc_vec2 cm;
     if (w == NULL) return LC_ERR_NULL;
     if (d == NULL) return lc_fail(w, LC_ERR_NULL, "body def is NULL");
+    if (out_id == NULL) return lc_fail(w, LC_ERR_NULL, "out_id is NULL (the new body's id must go somewhere)");
     if (d->type != LC_BODY_DYNAMIC && d->type != LC_BODY_STATIC)
         return lc_fail(w, LC_ERR_BAD_ENUM, "body type = %d is not an lc_body_type", (int)d->type);
     TRY(check_vec(w, d->position, 1e9, "position"));
@@ -572,9 +573,11 @@ int lc_body_vertex_count(const lc_world *w, lc_body_id id)
 lc_status lc_body_get_local_vertices(const lc_world *w, lc_body_id id, lc_vec2 *out, int capacity)
 {
     int row = row_of(w, id), i;
-    if (w == NULL || out == NULL) return LC_ERR_NULL;
-    if (row < 0) return LC_ERR_UNKNOWN_BODY;
-    if (capacity < w->shape[row].count) return LC_ERR_OUT_OF_RANGE;
+    if (w == NULL) return LC_ERR_NULL;
+    if (out == NULL) return lc_fail((lc_world *)w, LC_ERR_NULL, "out is NULL");
+    if (row < 0) return lc_fail((lc_world *)w, LC_ERR_UNKNOWN_BODY, "no body with id %u", (unsigned)id);
+    if (capacity < w->shape[row].count)
+        return lc_fail((lc_world *)w, LC_ERR_OUT_OF_RANGE, "capacity %d is below the body's %d vertices", capacity, w->shape[row].count);
     for (i = 0; i < w->shape[row].count; ++i) out[i] = w->shape[row].v[i];
     return LC_OK;
 }
@@ -584,9 +587,11 @@ lc_status lc_body_get_world_vertices(const lc_world *w, lc_body_id id, lc_vec2 *
     int row = row_of(w, id), i;
     double c, s;
     const double *st;
-    if (w == NULL || out == NULL) return LC_ERR_NULL;
-    if (row < 0) return LC_ERR_UNKNOWN_BODY;
-    if (capacity < w->shape[row].count) return LC_ERR_OUT_OF_RANGE;
+    if (w == NULL) return LC_ERR_NULL;
+    if (out == NULL) return lc_fail((lc_world *)w, LC_ERR_NULL, "out is NULL");
+    if (row < 0) return lc_fail((lc_world *)w, LC_ERR_UNKNOWN_BODY, "no body with id %u", (unsigned)id);
+    if (capacity < w->shape[row].count)
+        return lc_fail((lc_world *)w, LC_ERR_OUT_OF_RANGE, "capacity %d is below the body's %d vertices", capacity, w->shape[row].count);
     st = &w->state[row * 6];
     c = cos(st[SA]);
     s = sin(st[SA]);
@@ -598,8 +603,9 @@ lc_status lc_body_get_world_vertices(const lc_world *w, lc_body_id id, lc_vec2 *
 lc_status lc_body_get_center_offset(const lc_world *w, lc_body_id id, lc_vec2 *out)
 {
     int row = row_of(w, id);
-    if (w == NULL || out == NULL) return LC_ERR_NULL;
-    if (row < 0) return LC_ERR_UNKNOWN_BODY;
+    if (w == NULL) return LC_ERR_NULL;
+    if (out == NULL) return lc_fail((lc_world *)w, LC_ERR_NULL, "out is NULL");
+    if (row < 0) return lc_fail((lc_world *)w, LC_ERR_UNKNOWN_BODY, "no body with id %u", (unsigned)id);
     *out = w->shape[row].center_offset;
     return LC_OK;
 }

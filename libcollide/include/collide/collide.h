@@ -54,7 +54,7 @@ lc_status lc_world_step(lc_world *world, double dt);
 
 /* ---- bodies ------------------------------------------------------------------------------- */
 
-/* Adds a body; its id is written to out_id. */
+/* Adds a body; its id is written to out_id (required). */
 lc_status lc_world_add_body(lc_world *world, const lc_body_def *def, lc_body_id *out_id);
 /* Adds four static walls (thickness m) whose inner faces bound [xmin,xmax] x [ymin,ymax];
  * ids in the order bottom, right, top, left (out_ids may be NULL). */
@@ -82,7 +82,8 @@ lc_status lc_body_set_material(lc_world *world, lc_body_id id, double elasticity
 lc_status lc_body_set_external(lc_world *world, lc_body_id id, lc_vec2 force, double torque);
 /* Number of vertices of a body. */
 int lc_body_vertex_count(const lc_world *world, lc_body_id id);
-/* Writes a body's vertices relative to its centre of mass, body frame (m), into out[capacity]. */
+/* Writes a body's vertices relative to its centre of mass, body frame (m), into out[capacity].
+ * Like every getter on a const world, a failure still records its reason for lc_world_last_error(). */
 lc_status lc_body_get_local_vertices(const lc_world *world, lc_body_id id, lc_vec2 *out, int capacity);
 /* Writes a body's vertices in world coordinates (m) into out[capacity]. */
 lc_status lc_body_get_world_vertices(const lc_world *world, lc_body_id id, lc_vec2 *out, int capacity);
