@@ -196,7 +196,7 @@ lc_status lc_world_step(lc_world *w, double dt)
 
     remaining = dt;
     while (remaining > 0.0) {
-        int np, nc = 0, best = -1, nimp, hits;
+        int np, nc = 0, best = -1, nimp, hits, *coupled = NULL;
         double tmin = remaining;
         const int *pairs;
         lc_crossing *cross;
@@ -223,17 +223,39 @@ lc_status lc_world_step(lc_world *w, double dt)
             if (nc < 0) goto oom;
         }
         cross = (lc_crossing *)w->b_cross.p;
+        if (nc > 0) {
+            /* a body touching nothing and tied by no spring to another body moves on its own: its
+             * time-of-impact evaluations need only the two bodies, not the whole world */
+            coupled = lc_buf_get(&w->b_coupled, (size_t)w->count * sizeof(int));
+            if (coupled == NULL) goto oom;
+            memset(coupled, 0, (size_t)w->count * sizeof(int));
+            for (i = 0; i < nrest; ++i) coupled[rest[i].a] = coupled[rest[i].b] = 1;
+            for (i = 0; i < w->spring_count; ++i)
+                if (w->springs[i].def.body_b != LC_WORLD_ANCHOR) {
+                    coupled[lc_world_body_index(w, w->springs[i].def.body_a)] = 1;
+                    coupled[lc_world_body_index(w, w->springs[i].def.body_b)] = 1;
+                }
+        }
 
         /* earliest time of impact; a crossing whose gap is still open at the best time so far is later */
         for (i = 0; i < nc; ++i) {
             double tau;
+            int pair[2], npair = 0;
+            const int *erows = rows;
+            int nerows = nrows;
+            if (!coupled[cross[i].a] && !coupled[cross[i].b]) {
+                if (!w->is_static[cross[i].a]) pair[npair++] = cross[i].a;
+                if (!w->is_static[cross[i].b]) pair[npair++] = cross[i].b;
+                erows = pair;
+                nerows = npair;
+            }
             if (best >= 0) {
                 double g;
-                if (lc_integrate(w, s0, tmin, rows, nrows, rest, nrest, scratch) != 0) goto oom;
+                if (lc_integrate(w, s0, tmin, erows, nerows, rest, nrest, scratch) != 0) goto oom;
                 g = lc_vertex_edge_gap(w, scratch, cross[i].a, cross[i].vertex, cross[i].b, cross[i].edge);
                 if (g > w->def.contact_gap) continue;
             }
-            tau = lc_time_of_impact(w, s0, tmin, &cross[i], rows, nrows, rest, nrest, scratch);
+            tau = lc_time_of_impact(w, s0, tmin, &cross[i], erows, nerows, rest, nrest, scratch);
             if (tau < 0.0) continue;
             if (best < 0 || tau < tmin) { tmin = tau; best = i; }
         }
