@@ -1,0 +1,310 @@
+"""Record the sim node's topics to a rosbag2 directory (MCAP storage, metadata version 9).
+
+    python -m collide_ros.recorder --out DIR [--topics T ...] [--duration S] [--ros-args ...]
+
+Subscribes with raw=True (CDR bytes are written as received, never re-serialized) and
+stores each message at its receive time (what Jazzy's `ros2 bag record` stores). QoS is
+adapted to the publishers seen in the graph, as rosbag2 does: reliable only if every
+publisher is reliable, transient_local only if every publisher is. Message definitions and
+RIHS01 type hashes come from the installed interface packages (libcollide_msgs and our
+rebuilt tf2_msgs) and from rosbags' Jazzy typestore for the standard messages; the hash of
+our own types is checked against the hash rosidl generated. Stops on --duration, SIGINT or
+SIGTERM, then prints the message count per topic.
+"""
+from __future__ import annotations
+
+import argparse
+import importlib
+import json
+import os
+import signal
+import sys
+import time
+from pathlib import Path
+from typing import Any, Iterable
+
+#: topics recorded when --topics is not given and nothing else is discovered; more are
+#: picked up from the graph as they appear (all topics except the excluded ones)
+EXCLUDED = frozenset({"/rosout", "/parameter_events"})
+OWN_PACKAGES = ("libcollide_msgs", "tf2_msgs")
+COMMAND_TOPICS = ("thrusters", "spring", "cmd_vel")  # plus every "<body>/thrust"
+
+
+# ------------------------------------------------------------------ types / typestore
+
+def _share_dirs(pkg: str) -> list[Path]:
+    """Candidate share/<pkg> directories of an installed interface package."""
+    cands: list[Path] = []
+    for pre in os.environ.get("AMENT_PREFIX_PATH", "").split(os.pathsep):
+        if pre:
+            cands.append(Path(pre) / "share" / pkg)
+    cands.append(Path(sys.prefix) / "share" / pkg)
+    try:
+        mod = importlib.import_module(pkg)
+        # <prefix>/lib/python3.11/site-packages/<pkg>/__init__.py -> <prefix>/share/<pkg>
+        p = Path(mod.__file__ or "").resolve().parent
+        for up in p.parents:
+            cands.append(up / "share" / pkg)
+            if up.name == "lib":
+                break
+    except ImportError:
+        pass
+    repo = Path(__file__).resolve().parents[2] / "msg" / pkg  # source tree fallback
+    cands.append(repo)
+    return [c for c in dict.fromkeys(cands) if (c / "msg").is_dir()]
+
+
+def installed_type_hash(msgtype: str) -> str | None:
+    """RIHS01 hash rosidl generated for `pkg/msg/Name` (from share/pkg/msg/Name.json)."""
+    pkg, _, name = msgtype.split("/")
+    for d in _share_dirs(pkg):
+        f = d / "msg" / f"{name}.json"
+        if f.is_file():
+            data = json.loads(f.read_text())
+            for entry in data.get("type_hashes", []):
+                if entry.get("type_name") == msgtype:
+                    return str(entry["hash_string"])
+    return None
+
+
+def make_typestore() -> Any:
+    """rosbags Jazzy typestore plus our interface packages' message definitions."""
+    from rosbags.typesys import Stores, get_types_from_msg, get_typestore
+
+    store = get_typestore(Stores.ROS2_JAZZY)
+    add: dict[str, Any] = {}
+    for pkg in OWN_PACKAGES:
+        dirs = _share_dirs(pkg)
+        if not dirs:
+            continue
+        for f in sorted((dirs[0] / "msg").glob("*.msg")):
+            name = f"{pkg}/msg/{f.stem}"
+            if pkg == "tf2_msgs" and name in store.fielddefs:
+                continue  # identical definition already in the Jazzy store
+            add.update(get_types_from_msg(f.read_text(), name))
+    store.register(add)
+    return store
+
+
+def msgdef_and_hash(store: Any, msgtype: str) -> tuple[str, str]:
+    """(concatenated ros2msg definition, RIHS01 hash) for a bag connection."""
+    msgdef, _ = store.generate_msgdef(msgtype, ros_version=2)
+    computed = store.hash_rihs01(msgtype)
+    installed = installed_type_hash(msgtype)
+    if installed is not None and installed != computed:
+        raise RuntimeError(f"type hash mismatch for {msgtype}: installed {installed}, "
+                           f"from definition {computed}")
+    return msgdef, computed
+
+
+def msg_class(msgtype: str) -> Any:
+    pkg, sub, name = msgtype.split("/")
+    return getattr(importlib.import_module(f"{pkg}.{sub}"), name)
+
+
+def bag_qos(profile: Any) -> Any:
+    """rclpy QoSProfile -> rosbags Qos (for offered_qos_profiles)."""
+    from rosbags.interfaces import (Qos, QosDurability, QosHistory, QosLiveliness,
+                                    QosReliability, QosTime)
+
+    def t(d: Any) -> QosTime:
+        ns = int(d.nanoseconds)
+        return QosTime(sec=ns // 1_000_000_000, nsec=ns % 1_000_000_000)
+
+    def enum(cls: Any, v: Any) -> Any:
+        try:
+            return cls[v.name]
+        except KeyError:
+            return cls.UNKNOWN
+
+    return Qos(history=enum(QosHistory, profile.history), depth=int(profile.depth),
+               reliability=enum(QosReliability, profile.reliability),
+               durability=enum(QosDurability, profile.durability),
+               deadline=t(profile.deadline), lifespan=t(profile.lifespan),
+               liveliness=enum(QosLiveliness, profile.liveliness),
+               liveliness_lease_duration=t(profile.liveliness_lease_duration),
+               avoid_ros_namespace_conventions=bool(profile.avoid_ros_namespace_conventions))
+
+
+# ------------------------------------------------------------------ recorder
+
+class Recorder:
+    """Subscribes raw to topics as their publishers appear and writes them to an MCAP bag."""
+
+    def __init__(self, node: Any, out: str | Path, topics: Iterable[str] | None = None) -> None:
+        from rosbags.rosbag2 import StoragePlugin, Writer
+
+        self.node = node
+        self.store = make_typestore()
+        self.wanted = None if topics is None else {self._resolve(t) for t in topics}
+        self.writer = Writer(Path(out), version=9, storage_plugin=StoragePlugin.MCAP)
+        self.writer.open()
+        self.subs: dict[str, Any] = {}
+        self.conns: dict[str, Any] = {}
+        self.counts: dict[str, int] = {}
+        self.closed = False
+        self._timer = node.create_timer(0.2, self.discover)
+        self.discover()
+
+    def _resolve(self, topic: str) -> str:
+        from rclpy.expand_topic_name import expand_topic_name
+        return expand_topic_name(topic, self.node.get_name(), self.node.get_namespace())
+
+    def discover(self) -> None:
+        """Subscribe to every wanted topic that now has a publisher."""
+        if self.closed:
+            return
+        for name, types in self.node.get_topic_names_and_types():
+            if name in self.subs or not types:
+                continue
+            if self.wanted is None:
+                if name in EXCLUDED:
+                    continue
+            elif name not in self.wanted:
+                continue
+            pubs = [p for p in self.node.get_publishers_info_by_topic(name)
+                    if p.node_name != self.node.get_name()
+                    or p.node_namespace != self.node.get_namespace()]
+            if not pubs:
+                continue
+            self._subscribe(name, types[0], pubs)
+
+    def _subscribe(self, topic: str, msgtype: str, pubs: list[Any]) -> None:
+        from rclpy.qos import (DurabilityPolicy, HistoryPolicy, QoSProfile,
+                               ReliabilityPolicy)
+
+        try:
+            cls = msg_class(msgtype)
+            msgdef, rihs = msgdef_and_hash(self.store, msgtype)
+        except Exception as exc:  # unknown type: skip the topic, say why once
+            self.node.get_logger().warning(f"not recording {topic} [{msgtype}]: {exc}")
+            self.subs[topic] = None
+            return
+        reliable = all(p.qos_profile.reliability == ReliabilityPolicy.RELIABLE for p in pubs)
+        latched = all(p.qos_profile.durability == DurabilityPolicy.TRANSIENT_LOCAL for p in pubs)
+        qos = QoSProfile(
+            history=HistoryPolicy.KEEP_LAST, depth=1000,
+            reliability=ReliabilityPolicy.RELIABLE if reliable else ReliabilityPolicy.BEST_EFFORT,
+            durability=DurabilityPolicy.TRANSIENT_LOCAL if latched else DurabilityPolicy.VOLATILE)
+        conn = self.writer.add_connection(
+            topic, msgtype, msgdef=msgdef, rihs01=rihs,
+            offered_qos_profiles=[bag_qos(p.qos_profile) for p in pubs])
+        self.conns[topic] = conn
+        self.counts[topic] = 0
+
+        def cb(data: bytes, info: Any, topic: str = topic, conn: Any = conn) -> None:
+            if self.closed:
+                return
+            ts = info["received_timestamp"] if isinstance(info, dict) else time.time_ns()
+            self.writer.write(conn, int(ts), data)
+            self.counts[topic] += 1
+
+        self.subs[topic] = self.node.create_subscription(cls, topic, cb, qos, raw=True)
+
+    def subscribed(self) -> list[str]:
+        return sorted(t for t, s in self.subs.items() if s is not None)
+
+    def close(self) -> dict[str, int]:
+        if not self.closed:
+            self.closed = True
+            self.node.destroy_timer(self._timer)
+            for s in self.subs.values():
+                if s is not None:
+                    self.node.destroy_subscription(s)
+            self.writer.close()
+        return dict(self.counts)
+
+
+def snapshot_params(node: Any, target: str, timeout: float = 5.0) -> dict[str, Any] | None:
+    """All parameters of node `target` (e.g. "sim"), or None when it does not answer in time."""
+    import rclpy
+    from rclpy.parameter import parameter_value_to_python
+    from rclpy.parameter_client import AsyncParameterClient
+
+    client = AsyncParameterClient(node, target)
+    if not client.wait_for_services(timeout_sec=timeout):
+        return None
+    fut = client.list_parameters()
+    rclpy.spin_until_future_complete(node, fut, timeout_sec=timeout)
+    if not fut.done() or fut.result() is None:
+        return None
+    names = sorted(fut.result().result.names)
+    fut = client.get_parameters(names)
+    rclpy.spin_until_future_complete(node, fut, timeout_sec=timeout)
+    if not fut.done() or fut.result() is None:
+        return None
+    return {n: parameter_value_to_python(v) for n, v in zip(names, fut.result().values)}
+
+
+PARAMS_KEY = "collide_ros.params"
+
+
+def format_counts(counts: dict[str, int]) -> str:
+    width = max([len(t) for t in counts] + [5])
+    lines = [f"  {t:<{width}}  {n:>7}" for t, n in sorted(counts.items())]
+    lines.append(f"  {'total':<{width}}  {sum(counts.values()):>7}")
+    return "\n".join(lines)
+
+
+def main(argv: list[str] | None = None) -> int:
+    import rclpy
+    from rclpy.executors import SingleThreadedExecutor
+
+    argv = list(sys.argv[1:] if argv is None else argv)
+    if "--ros-args" in argv:
+        argv = argv[:argv.index("--ros-args")]
+    p = argparse.ArgumentParser(prog="python -m collide_ros.recorder", description=__doc__,
+                                formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--out", required=True, help="bag directory to create (must not exist)")
+    p.add_argument("--topics", nargs="*", default=None,
+                   help="topics to record (relative names resolve in the recorder's "
+                        "namespace); default: every topic except /rosout, /parameter_events")
+    p.add_argument("--duration", type=float, default=0.0, help="stop after S seconds (0 = on signal)")
+    p.add_argument("--node-name", default="recorder")
+    p.add_argument("--params-of", default=None, metavar="NODE",
+                   help="store this node's parameters (e.g. 'sim') in the bag's custom_data, "
+                        "for replay")
+    a = p.parse_args(argv)
+    if Path(a.out).exists():
+        p.error(f"{a.out} exists already")
+
+    rclpy.init(args=sys.argv)
+    node = rclpy.create_node(a.node_name)
+    rec = Recorder(node, a.out, a.topics)
+    if a.params_of:
+        params = snapshot_params(node, a.params_of)
+        if params is None:
+            print(f"recorder: no parameters from {a.params_of!r}", file=sys.stderr, flush=True)
+        else:
+            rec.writer.set_custom_data(PARAMS_KEY, json.dumps(params, sort_keys=True))
+            print(f"recorder: stored {len(params)} parameters of {a.params_of}", flush=True)
+    stop = {"flag": False}
+
+    def on_signal(signum: int, frame: Any) -> None:
+        stop["flag"] = True
+
+    signal.signal(signal.SIGINT, on_signal)
+    signal.signal(signal.SIGTERM, on_signal)
+    ex = SingleThreadedExecutor()
+    ex.add_node(node)
+    print(f"recorder: writing {a.out} (mcap, rosbag2 v9)", flush=True)
+    t_end = time.monotonic() + a.duration if a.duration > 0 else float("inf")
+    announced: set[str] = set()
+    try:
+        while not stop["flag"] and time.monotonic() < t_end:
+            ex.spin_once(timeout_sec=0.05)
+            new = set(rec.subscribed()) - announced
+            for t in sorted(new):
+                print(f"recorder: subscribed {t}", flush=True)
+            announced |= new
+    finally:
+        counts = rec.close()
+        ex.remove_node(node)
+        node.destroy_node()
+        rclpy.try_shutdown()
+    print(f"recorder: wrote {a.out}\n{format_counts(counts)}", flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
