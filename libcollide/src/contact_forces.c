@@ -144,6 +144,61 @@ static int solve_with_friction(lc_world *w, const double *state, lc_touch *sub, 
     return 0;
 }
 
+/* Projected Gauss-Seidel in body space for groups above lcp_exact_max: the matrix A = J M^-1 J^T is
+ * never formed; each sweep costs O(points) instead of O(points^2). Returns sweeps, residual in *res. */
+static int solve_sparse(lc_world *w, lc_touch *t, int m, const double *b, double *f, double *res)
+{
+    double *diag = lc_buf_get(&w->b_diag, (size_t)m * sizeof(double));
+    double *dacc = lc_buf_get(&w->b_dacc, (size_t)w->count * 3 * sizeof(double));
+    double bmax = 0.0, worst = 0.0;
+    int i, sweep;
+    if (!diag || !dacc) return -1;
+    memset(dacc, 0, (size_t)w->count * 3 * sizeof(double));
+    for (i = 0; i < m; ++i) {
+        diag[i] = response(w, &t[i], &t[i]);
+        f[i] = 0.0;
+        if (fabs(b[i]) > bmax) bmax = fabs(b[i]);
+    }
+    for (sweep = 1; sweep <= w->def.lcp_max_iterations; ++sweep) {
+        worst = 0.0;
+        for (i = 0; i < m; ++i) {
+            const lc_touch *ti = &t[i];
+            double a = b[i], fn, df;
+            if (!w->is_static[ti->a]) {
+                const double *d = &dacc[ti->a * 3];
+                a += lc_dot(ti->n, lc_add(lc_v(d[0], d[1]), lc_wcross(d[2], ti->ra)));
+            }
+            if (!w->is_static[ti->b]) {
+                const double *d = &dacc[ti->b * 3];
+                a -= lc_dot(ti->n, lc_add(lc_v(d[0], d[1]), lc_wcross(d[2], ti->rb)));
+            }
+            /* residual of the complementarity conditions before this update */
+            if (fabs(fmin(f[i], a)) > worst) worst = fabs(fmin(f[i], a));
+            if (!(diag[i] > 0.0)) continue;
+            fn = f[i] - a / diag[i];
+            if (fn < 0.0) fn = 0.0;
+            df = fn - f[i];
+            f[i] = fn;
+            if (df != 0.0) {
+                lc_vec2 F = lc_scale(ti->n, df);
+                if (!w->is_static[ti->a]) {
+                    dacc[ti->a * 3 + 0] += F.x * w->inv_mass[ti->a];
+                    dacc[ti->a * 3 + 1] += F.y * w->inv_mass[ti->a];
+                    dacc[ti->a * 3 + 2] += lc_cross(ti->ra, F) * w->inv_inertia[ti->a];
+                }
+                if (!w->is_static[ti->b]) {
+                    dacc[ti->b * 3 + 0] -= F.x * w->inv_mass[ti->b];
+                    dacc[ti->b * 3 + 1] -= F.y * w->inv_mass[ti->b];
+                    dacc[ti->b * 3 + 2] -= lc_cross(ti->rb, F) * w->inv_inertia[ti->b];
+                }
+            }
+        }
+        if (worst <= w->def.lcp_tolerance * (bmax + 1e-300)) break;
+    }
+    *res = worst / (bmax + 1e-300);
+    return sweep > w->def.lcp_max_iterations ? w->def.lcp_max_iterations : sweep;
+}
+
 int lc_contact_forces(lc_world *w, const double *state, lc_touch *touches, int n, double *acc)
 {
     int *parent, *order, *group;
@@ -192,7 +247,7 @@ int lc_contact_forces(lc_world *w, const double *state, lc_touch *touches, int n
         while (g1 < n && group[order[g1]] == group[order[g0]]) ++g1;
         m = g1 - g0;
         sub = lc_buf_get(&w->b_rest, (size_t)m * sizeof(lc_touch));
-        A = lc_buf_get(&w->b_mat, (size_t)m * (size_t)m * sizeof(double));
+        A = lc_buf_get(&w->b_mat, m > w->def.lcp_exact_max ? sizeof(double) : (size_t)m * (size_t)m * sizeof(double));
         b = lc_buf_get(&w->b_vec, (size_t)m * sizeof(double));
         f = lc_buf_get(&w->b_vec2, (size_t)m * sizeof(double));
         if (!sub || !A || !b || !f) return -1;
@@ -210,6 +265,17 @@ int lc_contact_forces(lc_world *w, const double *state, lc_touch *touches, int n
                 continue;
             }
         }
+        if (m > w->def.lcp_exact_max) {
+            double resid;
+            int sweeps;
+            for (j = 0; j < m; ++j)
+                b[j] = free_acceleration(w, state, &sub[j], acc, sub[j].n) + kv * sub[j].vn +
+                       kd * (sub[j].gap - w->def.contact_gap);
+            sweeps = solve_sparse(w, sub, m, b, f, &resid);
+            if (sweeps < 0) return -1;
+            res.iterations = sweeps;
+            res.residual = resid;
+        } else {
         lc_response_matrix(w, sub, m, A);
         for (j = 0; j < m; ++j) {
             b[j] = free_acceleration(w, state, &sub[j], acc, sub[j].n) + kv * sub[j].vn +
@@ -217,6 +283,7 @@ int lc_contact_forces(lc_world *w, const double *state, lc_touch *touches, int n
             f[j] = 0.0;
         }
         lc_lcp_solve(m, A, b, f, NULL, &opt, w->lcp, &res);
+        }
         w->last.contact_solves++;
         w->last.contact_solve_iterations += (uint64_t)res.iterations;
         w->last.resting_contacts += (uint64_t)m;

@@ -174,7 +174,13 @@ int lc_resolve_impacts(lc_world *w, double *state, lc_touch *t, int n)
         if (k < 0) return -1;
         hits += k;
     } else {
-        for (iter = 0; iter < w->def.max_serial_iterations; ++iter) {
+        /* A pair resolved over and over is a jam (blocks pressed together, a resting pile), not a
+         * propagating impact: after a few passes per pair the inelastic simultaneous pass closes it. */
+        int pairs = 1, cap;
+        for (i = 1; i < n; ++i) if (!same_pair(&t[i], &t[i - 1])) ++pairs;
+        cap = 4 * pairs + 16;
+        if (cap > w->def.max_serial_iterations) cap = w->def.max_serial_iterations;
+        for (iter = 0; iter < cap; ++iter) {
             int worst = -1, start, end, k;
             double vworst = -eps;
             for (i = 0; i < n; ++i) {
@@ -193,7 +199,7 @@ int lc_resolve_impacts(lc_world *w, double *state, lc_touch *t, int n)
             hits += k;
             if (k == 0) break;   /* the solver found nothing to do: avoid spinning */
         }
-        if (iter == w->def.max_serial_iterations) {
+        if (iter == cap) {
             /* e.g. e = 1 between bodies wedged against each other: close the event inelastically */
             int k = solve_block(w, state, t, n, 0);
             if (k < 0) return -1;

@@ -69,51 +69,70 @@ static double mix(lc_mix_rule r, double x, double y)
     return x < y ? x : y;
 }
 
-/* Touches of the vertices of body `a` against the edges of body `b`. */
-static int touches_one_way(const lc_world *w, const double *state, int a, int b, double max_gap,
-                           lc_buf *buf, int count, int first_of_pair)
+static int push_touch(const lc_world *w, const double *state, lc_buf *buf, int count, int first_of_pair,
+                      int a, int vertex, int b, int edge, double max_gap)
+{
+    lc_touch *t = (lc_touch *)buf->p;
+    lc_vec2 p = to_world(frame_of(state, a), w->shape[a].v[vertex]);
+    int j;
+    /* a point already recorded for this pair at (nearly) the same place is the same contact */
+    for (j = first_of_pair; j < count; ++j) {
+        lc_vec2 d = lc_sub(t[j].p, p);
+        if (lc_dot(d, d) < max_gap * max_gap) return count;
+    }
+    t = lc_buf_get(buf, (size_t)(count + 1) * sizeof(lc_touch));
+    if (t == NULL) return -1;
+    t += count;
+    t->a = a;
+    t->b = b;
+    t->vertex = vertex;
+    t->edge = edge;
+    t->elasticity = mix(w->def.elasticity_rule, w->elasticity[a], w->elasticity[b]);
+    t->friction = mix(w->def.friction_rule, w->friction[a], w->friction[b]);
+    t->value = 0.0;
+    t->vn_pre = 0.0;
+    t->target_vn = 0.0;
+    t->tangent = 0.0;
+    lc_touch_update(w, state, t);
+    return count + 1;
+}
+
+/* Largest separation of body `a`'s vertices along the outward normals of `b`'s edges (the separating
+ * axis test): returns it and the edge in *edge. */
+static double max_separation(const lc_world *w, const double *state, int a, int b, int *edge)
 {
     const lc_shape *sa = &w->shape[a], *sb = &w->shape[b];
     frame fa = frame_of(state, a), fb = frame_of(state, b);
-    int i, k, j;
-    for (i = 0; i < sa->count; ++i) {
-        lc_vec2 local = to_local(fb, to_world(fa, sa->v[i]));
-        double best = -INFINITY, len, u;
-        int best_k = -1;
-        lc_touch *t;
-        for (k = 0; k < sb->count; ++k) {
-            double d = edge_distance(sb, k, local);
-            if (d > best) { best = d; best_k = k; }
+    lc_vec2 local[LC_MAX_POLYGON_VERTICES];
+    double best = -INFINITY;
+    int i, k;
+    for (i = 0; i < sa->count; ++i) local[i] = to_local(fb, to_world(fa, sa->v[i]));
+    *edge = 0;
+    for (k = 0; k < sb->count; ++k) {
+        double sep = INFINITY;
+        for (i = 0; i < sa->count; ++i) {
+            double d = edge_distance(sb, k, local[i]);
+            if (d < sep) sep = d;
         }
-        if (!(best < max_gap)) continue;
-        u = edge_param(sb, best_k, local, &len);
-        /* beyond the edge's ends by more than the touch distance: a corner-corner near miss */
+        if (sep > best) { best = sep; *edge = k; }
+    }
+    return best;
+}
+
+/* Vertices of body `inc` within max_gap of edge `edge` of body `ref` (and over its extent). */
+static int face_touches(const lc_world *w, const double *state, int inc, int ref, int edge, double max_gap,
+                        lc_buf *buf, int count, int first_of_pair)
+{
+    const lc_shape *si = &w->shape[inc], *sr = &w->shape[ref];
+    frame fi = frame_of(state, inc), fr = frame_of(state, ref);
+    int i;
+    for (i = 0; i < si->count && count >= 0; ++i) {
+        lc_vec2 local = to_local(fr, to_world(fi, si->v[i]));
+        double d = edge_distance(sr, edge, local), len, u;
+        if (!(d < max_gap)) continue;
+        u = edge_param(sr, edge, local, &len);
         if (u * len < -max_gap || (u - 1.0) * len > max_gap) continue;
-        /* a point already recorded for this pair at (nearly) the same place is the same contact */
-        {
-            lc_vec2 p = to_world(fa, sa->v[i]);
-            int dup = 0;
-            t = (lc_touch *)buf->p;
-            for (j = first_of_pair; j < count; ++j) {
-                lc_vec2 d = lc_sub(t[j].p, p);
-                if (lc_dot(d, d) < max_gap * max_gap) { dup = 1; break; }
-            }
-            if (dup) continue;
-        }
-        t = lc_buf_get(buf, (size_t)(count + 1) * sizeof(lc_touch));
-        if (t == NULL) return -1;
-        t += count;
-        t->a = a;
-        t->b = b;
-        t->vertex = i;
-        t->edge = best_k;
-        t->elasticity = mix(w->def.elasticity_rule, w->elasticity[a], w->elasticity[b]);
-        t->friction = mix(w->def.friction_rule, w->friction[a], w->friction[b]);
-        t->value = 0.0;
-        t->vn_pre = 0.0;
-        t->target_vn = 0.0;
-        lc_touch_update(w, state, t);
-        count++;
+        count = push_touch(w, state, buf, count, first_of_pair, inc, i, ref, edge, max_gap);
     }
     return count;
 }
@@ -121,11 +140,37 @@ static int touches_one_way(const lc_world *w, const double *state, int a, int b,
 int lc_collect_touches(const lc_world *w, const double *state, int a, int b, double max_gap,
                        lc_buf *buf, int count)
 {
-    int first = count;
+    int first = count, ka, kb, ref, inc, kref, kinc, k;
+    double sep_a, sep_b, best = INFINITY;
+    lc_vec2 n;
     if (w->is_static[a] && w->is_static[b]) return count;
-    count = touches_one_way(w, state, a, b, max_gap, buf, count, first);
+    /* The contact normal of a pair comes from its separating axis: the face of either body along
+     * which they are farthest apart (least overlap). At coincident corners of side-by-side boxes this
+     * picks the shared vertical faces, never the collinear top or bottom faces. */
+    sep_b = max_separation(w, state, a, b, &kb);   /* a's vertices against b's faces */
+    sep_a = max_separation(w, state, b, a, &ka);   /* b's vertices against a's faces */
+    if (!(sep_a < max_gap) && !(sep_b < max_gap)) return count;
+    /* ties (within a hundredth of the gap) go to b's face so the choice does not flicker */
+    if (sep_a > sep_b + 0.01 * w->def.contact_gap) { ref = a; kref = ka; inc = b; }
+    else { ref = b; kref = kb; inc = a; }
+    if (!(sep_a < max_gap) || !(sep_b < max_gap)) {
+        /* separated along one body's face by more than max_gap: not touching */
+        if ((ref == a ? sep_a : sep_b) >= max_gap) return count;
+    }
+    /* incident face: the face of the other body most opposed to the reference normal */
+    n = lc_rot(cos(state[ref * 6 + SA]), sin(state[ref * 6 + SA]), w->shape[ref].n[kref]);
+    kinc = 0;
+    {
+        double c = cos(state[inc * 6 + SA]), sn = sin(state[inc * 6 + SA]);
+        for (k = 0; k < w->shape[inc].count; ++k) {
+            double d = lc_dot(n, lc_rot(c, sn, w->shape[inc].n[k]));
+            if (d < best) { best = d; kinc = k; }
+        }
+    }
+    count = face_touches(w, state, inc, ref, kref, max_gap, buf, count, first);
     if (count < 0) return count;
-    return touches_one_way(w, state, b, a, max_gap, buf, count, first);
+    /* the reference body's corners under the incident face (offset boxes: one point each way) */
+    return face_touches(w, state, ref, inc, kinc, max_gap, buf, count, first);
 }
 
 static int crossings_one_way(const lc_world *w, const double *s0, const double *s1, int a, int b,

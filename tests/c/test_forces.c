@@ -177,7 +177,7 @@ static void spring_period(int two_body)
     lc_spring_id sid;
     lc_body_id a, b = 0;
     const double k = 5.0;
-    double mu, T, prev_x = 0, prev_v = 0, prev_t = 0, t_first = -1, t_last = -1;
+    double mu, T, prev_x = 0, prev_v = 0, prev_t = 0, t_first = -1, t_last = -1, e0, max_de = 0;
     int n_cross = 0, i;
     if (!w) return;
     if (!two_body) {
@@ -199,6 +199,9 @@ static void spring_period(int two_body)
     sd.stiffness = k;
     CHECK(lc_world_add_spring(w, &sd, &sid) == LC_OK, "add_spring: %s", lc_world_last_error(w));
     T = 2.0 * SC_PI * sqrt(mu / k);
+    /* spring energy k stretch^2 / 2 (stretch 1 m at release): exact, round-off 1e-14 */
+    CHECK_REL(sc_energy(w).spring, 0.5 * k * 1.0, 1e-14, "spring potential energy k stretch^2/2");
+    e0 = sc_energy(w).total;
     for (i = 0; i <= 2000; i++) {
         const double *sa = sc_row(w, a);
         double x, v, t = lc_world_get_time(w);
@@ -217,9 +220,13 @@ static void spring_period(int two_body)
             n_cross++;
         }
         prev_x = x; prev_v = v; prev_t = t;
+        if (fabs(sc_energy(w).total - e0) > max_de) max_de = fabs(sc_energy(w).total - e0);
         if (i < 2000 && sc_step_n(w, 0.01, 1) != 1) break;
     }
     CHECK(n_cross >= 5, "spring crossed zero %d times in 20 s", n_cross);
+    /* RK4 energy drift for an oscillator: ~ (w dt)^6 / 144 per step ~ 1e-13 relative, times 2000
+     * steps: 1e-10; tolerance 1e-8 relative of the 2.5 J */
+    CHECK_NEAR(max_de, 0.0, 1e-8 * e0, "spring oscillator energy (kinetic + spring) conserved");
     if (n_cross >= 2) {
         double Tm = 2.0 * (t_last - t_first) / (n_cross - 1);
         printf("spring (%s): period %.12f s, expected 2 pi sqrt(m/k) = %.12f s, rel err %.2e\n",

@@ -16,11 +16,25 @@ static void parabola(lc_integrator integ)
     lc_body_id id;
     const double x0 = -1.0, y0 = 2.0, a0 = 0.3, vx = 3.0, vy = 4.0, om = 2.0, g = 9.81;
     int k;
-    double maxerr_p = 0, maxerr_v = 0, maxerr_a = 0;
+    double maxerr_p = 0, maxerr_v = 0, maxerr_a = 0, e0, max_de = 0;
+    const double m = 1.5, I = 1.5 * 5.0 / 12.0, zel = 0.5;
     d.integrator = integ;
+    d.zero_energy_level = zel;
     w = sc_world(&d);
     if (!w) return;
-    id = sc_box(w, 1.0, 2.0, x0, y0, a0, vx, vy, om, 1.5, 1.0);
+    id = sc_box(w, 1.0, 2.0, x0, y0, a0, vx, vy, om, m, 1.0);
+    /* Energy split (exact formulas, round-off only: 1e-12 relative): translational m|v|^2/2,
+     * rotational I w^2/2, gravitational m g (y - zero_energy_level). */
+    {
+        lc_energy en = sc_energy(w);
+        CHECK_REL(en.translational, 0.5 * m * (vx * vx + vy * vy), 1e-12, "translational energy m|v|^2/2");
+        CHECK_REL(en.rotational, 0.5 * I * om * om, 1e-12, "rotational energy I w^2/2");
+        CHECK_REL(en.gravitational, m * g * (y0 - zel), 1e-12, "gravitational energy m g (y - zero level)");
+        CHECK_REL(en.total, en.translational + en.rotational + en.gravitational, 1e-12, "total = sum of parts");
+        CHECK_REL(en.linear_momentum.x, m * vx, 1e-12, "linear momentum x");
+        CHECK_REL(en.angular_momentum, m * (x0 * vy - y0 * vx) + I * om, 1e-12, "angular momentum about the origin");
+        e0 = en.total;
+    }
     for (k = 0; k < 400; k++) {
         const double *s;
         double t, ex, ey, ea, evx, evy;
@@ -38,7 +52,10 @@ static void parabola(lc_integrator integ)
         if (evx > maxerr_v) maxerr_v = evx;
         if (evy > maxerr_v) maxerr_v = evy;
         if (fabs(s[5] - om) > maxerr_a) maxerr_a = fabs(s[5] - om);
+        if (fabs(sc_energy(w).total - e0) > max_de) max_de = fabs(sc_energy(w).total - e0);
     }
+    /* free flight conserves energy; round-off only (|E| ~ 100 J, 1e-10 relative) */
+    CHECK_NEAR(max_de, 0.0, 1e-10 * fabs(e0), "free-flight energy conserved");
     CHECK_NEAR(lc_world_get_time(w), 2.0, 1e-12, "time after 400 steps of 5 ms (round-off of the sum)");
     printf("parabola (integrator %d): max |position error| %.3e m, |velocity error| %.3e m/s, "
            "|angle/omega error| %.3e\n", (int)integ, maxerr_p, maxerr_v, maxerr_a);

@@ -1,4 +1,6 @@
-/* test_resting: the seed's "stuck" cases and a stack.
+/* test_resting: the seed's "stuck" cases ((1) a block settling on the floor at e = 0.5, (2) two
+ * blocks pushed together by a spring, and by a mouse spring against a wall), (3) a stack of ten,
+ * (4) a thruster pushing a block into a block at the wall (contact forces = thrust).
  * Conventions: resting contacts are held at gap contact_gap (1e-7 m) and bodies "touch" below
  * contact_distance (1e-5 m). Tolerances:
  * - never penetrate more than PEN_TOL = 1e-9 m (1 % of contact_gap) at any step end: impacts are
@@ -167,6 +169,46 @@ static void stack(void)
     lc_world_destroy(w);
 }
 
+/* (4) g = 0: a thruster (1.5 N along +x at A's centre) pushes block A into block B, which rests
+ * against the right wall. At rest the forces balance: the A-B contact force and the B-wall contact
+ * force both equal the thrust, 1.5 N (to 1e-6 relative: the LCP residual is <= 1e-10 relative and
+ * the bodies are at rest); both gaps in [0, contact_distance], speeds < 1e-6 m/s. */
+static void pushed_chain(void)
+{
+    lc_world_def d = sc_def_zero_g();
+    lc_world *w = sc_world(&d);
+    lc_body_id walls[4], A, B;
+    lc_thruster_def td;
+    const lc_contact *cs;
+    double f_ab = 0, f_bw = 0, s_ab, s_bw;
+    int i, nc;
+    if (!w) return;
+    CHECK(lc_world_add_walls(w, -5, -5, 5, 5, 1.0, 0.5, walls) == LC_OK, "%s", "walls");
+    A = sc_box(w, 1.0, 1.0, 2.0, 0.0, 0.0, 0, 0, 0, 1.0, 0.5);
+    B = sc_box(w, 1.0, 1.0, 4.0, 0.0, 0.0, 0, 0, 0, 2.0, 0.5);
+    td.point.x = 0.0; td.point.y = 0.0; td.direction.x = 1.0; td.direction.y = 0.0; td.magnitude = 1.5;
+    CHECK(lc_body_add_thruster(w, A, &td, NULL) == LC_OK, "%s", "thruster");
+    CHECK(lc_body_set_thruster_level(w, A, 0, 1.0) == LC_OK, "%s", "level");
+    CHECK(sc_step_n(w, 0.01, 2000) == 2000, "%s", "20 s without error");
+    nc = sc_contacts(w, &cs);
+    for (i = 0; i < nc; i++) {
+        if (cs[i].kind != LC_CONTACT_RESTING) continue;
+        if ((cs[i].body_a == A && cs[i].body_b == B) || (cs[i].body_a == B && cs[i].body_b == A)) f_ab += cs[i].force;
+        else if (cs[i].body_a == walls[1] || cs[i].body_b == walls[1]) f_bw += cs[i].force;
+    }
+    s_ab = sc_separation(w, A, B);
+    s_bw = sc_separation(w, B, walls[1]);
+    printf("pushed chain: F(A,B) %.12f N, F(B,wall) %.12f N, gaps %.3e %.3e m, |vA| %.3e |vB| %.3e\n", f_ab, f_bw,
+           s_ab, s_bw, hypot(sc_row(w, A)[3], sc_row(w, A)[4]), hypot(sc_row(w, B)[3], sc_row(w, B)[4]));
+    CHECK_REL(f_ab, 1.5, 1e-6, "contact force A-B = thrust");
+    CHECK_REL(f_bw, 1.5, 1e-6, "contact force B-wall = thrust");
+    CHECK(s_ab >= 0 && s_ab <= d.contact_distance && s_bw >= 0 && s_bw <= d.contact_distance,
+          "pushed chain: gaps %.3e %.3e not in [0, contact_distance]", s_ab, s_bw);
+    CHECK(hypot(sc_row(w, A)[3], sc_row(w, A)[4]) < 1e-6 && hypot(sc_row(w, B)[3], sc_row(w, B)[4]) < 1e-6, "%s",
+          "pushed chain at rest");
+    lc_world_destroy(w);
+}
+
 int main(void)
 {
     settle(0.0, 0.0, "flat block settling on the floor");
@@ -174,5 +216,6 @@ int main(void)
     spring_pair(0);
     spring_pair(1);
     stack();
+    pushed_chain();
     return CHECK_SUMMARY("test_resting");
 }

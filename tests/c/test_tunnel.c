@@ -44,11 +44,57 @@ static void shoot(double vx, double vy, double angle, double omega, const char *
     lc_world_destroy(w);
 }
 
+/* The block's lower half meets the wall's top end (wall top at y = 20 m here: wall spans
+ * [-20, 20]): the wall's corner hits the block's face and the block's corner the wall's face at
+ * once. It must bounce back, never overlapping the wall (separation >= -1e-9 m at step ends). */
+static void top_end(void)
+{
+    lc_world_def d = sc_def_zero_g();
+    lc_world *w = sc_world(&d);
+    lc_body_id wall, blk;
+    double worst = INFINITY;
+    int k;
+    if (!w) return;
+    wall = sc_static_box(w, 0.05, 40.0, 0.0, 0.0, 1.0);
+    blk = sc_box(w, 0.1, 0.1, -3.0, 20.0, 0.0, 150.0, 0.0, 0.0, 0.1, 1.0);
+    for (k = 0; k < 5; k++) {
+        double sp;
+        if (sc_step_n(w, 0.1, 1) != 1) break;
+        sp = sc_separation(w, blk, wall);
+        if (sp < worst) worst = sp;
+    }
+    printf("wall top end: min separation %.3e m, final vx %.6f\n", worst, sc_row(w, blk)[3]);
+    CHECK(worst >= -1e-9, "block overlapped the wall's end by %.3e m", -worst);
+    CHECK(sc_row(w, blk)[0] < 0.0, "block ended beyond the wall (x = %g)", sc_row(w, blk)[0]);
+    lc_world_destroy(w);
+}
+
+/* No false positive: the same block passing 1 mm above the wall's top never touches it. Its path
+ * is a straight line, so after 0.5 s it is exactly at x = -3 + 150 * 0.5 = 72 m (round-off 1e-12). */
+static void clear_pass(void)
+{
+    lc_world_def d = sc_def_zero_g();
+    lc_world *w = sc_world(&d);
+    lc_body_id blk;
+    lc_counters tot;
+    if (!w) return;
+    sc_static_box(w, 0.05, 40.0, 0.0, 0.0, 1.0);
+    blk = sc_box(w, 0.1, 0.1, -3.0, 20.0 + 0.05 + 1e-3, 0.0, 150.0, 0.0, 0.0, 0.1, 1.0);
+    sc_step_n(w, 0.1, 5);
+    lc_world_get_counters(w, NULL, &tot);
+    CHECK(tot.collisions == 0, "passing 1 mm above the wall: %llu collisions", (unsigned long long)tot.collisions);
+    CHECK_NEAR(sc_row(w, blk)[0], 72.0, 1e-12 * 72.0 * 5, "free path over the wall");
+    CHECK_NEAR(sc_row(w, blk)[3], 150.0, 0.0, "velocity untouched");
+    lc_world_destroy(w);
+}
+
 int main(void)
 {
     shoot(150.0, 0.0, 0.0, 0.0, "head-on 150 m/s");
     shoot(120.0, 15.0, 0.2, 0.0, "oblique 121 m/s, tilted");
     shoot(100.0, 5.0, 0.3, 60.0, "rotating 60 rad/s at 100 m/s");
     shoot(300.0, -20.0, 0.0, -150.0, "rotating 150 rad/s at 300 m/s");
+    top_end();
+    clear_pass();
     return CHECK_SUMMARY("test_tunnel");
 }
