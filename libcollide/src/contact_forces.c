@@ -155,9 +155,24 @@ static int solve_sparse(lc_world *w, lc_touch *t, int m, const double *b, double
     if (!diag || !dacc) return -1;
     memset(dacc, 0, (size_t)w->count * 3 * sizeof(double));
     for (i = 0; i < m; ++i) {
-        diag[i] = response(w, &t[i], &t[i]);
-        f[i] = 0.0;
+        const lc_touch *ti = &t[i];
+        diag[i] = response(w, ti, ti);
+        /* warm start from the force this touch carried last time */
+        f[i] = ti->value > 0.0 && isfinite(ti->value) ? ti->value : 0.0;
         if (fabs(b[i]) > bmax) bmax = fabs(b[i]);
+        if (f[i] > 0.0) {
+            lc_vec2 F = lc_scale(ti->n, f[i]);
+            if (!w->is_static[ti->a]) {
+                dacc[ti->a * 3 + 0] += F.x * w->inv_mass[ti->a];
+                dacc[ti->a * 3 + 1] += F.y * w->inv_mass[ti->a];
+                dacc[ti->a * 3 + 2] += lc_cross(ti->ra, F) * w->inv_inertia[ti->a];
+            }
+            if (!w->is_static[ti->b]) {
+                dacc[ti->b * 3 + 0] -= F.x * w->inv_mass[ti->b];
+                dacc[ti->b * 3 + 1] -= F.y * w->inv_mass[ti->b];
+                dacc[ti->b * 3 + 2] -= lc_cross(ti->rb, F) * w->inv_inertia[ti->b];
+            }
+        }
     }
     for (sweep = 1; sweep <= w->def.lcp_max_iterations; ++sweep) {
         worst = 0.0;

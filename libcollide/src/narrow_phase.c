@@ -202,7 +202,10 @@ static int crossings_one_way(const lc_world *w, const double *s0, const double *
                 double s = (d0 - level) / (d0 - d1), len, u;
                 lc_vec2 x = lc_add(l0, lc_scale(lc_sub(l1, l0), s));
                 u = edge_param(sb, k, x, &len);
-                if (u * len >= -w->def.contact_distance && (u - 1.0) * len <= w->def.contact_distance && s < first_s) {
+                /* strictly within the edge: a corner gliding just over the end of a neighbour's face
+                 * (a seam in the floor) does not hit that face; a path that really enters through the
+                 * corner ends inside and is caught below by the least-penetrated edge */
+                if (u >= 0.0 && u <= 1.0 && s < first_s) {
                     first_s = s;
                     hit = k;
                 }

@@ -213,7 +213,7 @@ void lc_world_destroy(lc_world *w)
     lc_buf_free(&w->b_pairs); lc_buf_free(&w->b_aabb); lc_buf_free(&w->b_rows); lc_buf_free(&w->b_island);
     lc_buf_free(&w->b_flags); lc_buf_free(&w->b_mat); lc_buf_free(&w->b_vec); lc_buf_free(&w->b_vec2);
     lc_buf_free(&w->b_vec3); lc_buf_free(&w->b_order); lc_buf_free(&w->b_cross);
-    lc_buf_free(&w->b_impact); lc_buf_free(&w->b_irows); lc_buf_free(&w->b_coupled); lc_buf_free(&w->b_dacc); lc_buf_free(&w->b_diag);
+    lc_buf_free(&w->b_impact); lc_buf_free(&w->b_irows); lc_buf_free(&w->b_coupled); lc_buf_free(&w->b_dacc); lc_buf_free(&w->b_diag); lc_buf_free(&w->b_warm); lc_buf_free(&w->b_hash);
     free(w);
 }
 
@@ -461,6 +461,7 @@ lc_status lc_world_remove_body(lc_world *w, lc_body_id id)
     for (i = row; i < w->count; ++i) w->id_to_row[w->ids[i]] = i;
     remove_springs_of(w, id);
     w->contact_count = 0;
+    w->warm_count = 0;   /* kept touches refer to rows, which just shifted */
     return ok(w);
 }
 

@@ -17,6 +17,8 @@
  *   sc_min_y(w, id), sc_max_x(w, id)   - extreme world vertex coordinates
  *   sc_rng                              - small deterministic generator (no global state)
  *   sc_step_n(w, dt, n)                - n steps; stops and fails a CHECK on the first non-OK status
+ *   sc_contacts(w, &cs)                - the last step's contacts and their count
+ *   sc_world_vertices(w, id, out)      - world vertices, returns the count
  */
 #ifndef LC_TESTS_SCENES_H
 #define LC_TESTS_SCENES_H
@@ -265,7 +267,7 @@ static inline int sc_step_n(lc_world *w, double dt, int n)
     return n;
 }
 
-/* Sum of a counter field over the collision contacts of the last step, and their count. */
+/* The contacts of the last step (collisions and resting) into *out; returns their count. */
 static inline int sc_contacts(const lc_world *w, const lc_contact **out)
 {
     int n = 0;

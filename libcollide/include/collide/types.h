@@ -203,6 +203,7 @@ typedef struct lc_counters {
     uint64_t contact_solves;          /* complementarity solves for contact forces */
     uint64_t contact_solve_iterations;/* pivots or sweeps in those solves */
     uint64_t impulse_solves;          /* complementarity solves for impulses */
+    uint64_t position_projections;    /* end-of-step corrections of points found inside another body */
     double max_lcp_residual;          /* largest complementarity residual of the iterative solver */
 } lc_counters;
 
