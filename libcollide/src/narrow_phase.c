@@ -173,11 +173,10 @@ int lc_collect_touches(const lc_world *w, const double *state, int a, int b, dou
     return face_touches(w, state, ref, inc, kinc, max_gap, buf, count, first);
 }
 
-static int crossings_one_way(const lc_world *w, const double *s0, const double *s1, int a, int b,
+static int crossings_one_way(const lc_world *w, int a, int b, frame fa0, frame fb0, frame fa1, frame fb1,
                              lc_buf *buf, int count)
 {
     const lc_shape *sa = &w->shape[a], *sb = &w->shape[b];
-    frame fa0 = frame_of(s0, a), fb0 = frame_of(s0, b), fa1 = frame_of(s1, a), fb1 = frame_of(s1, b);
     /* Penetrations shallower than half the contact gap are round-off around a resting contact (held at
      * contact_gap), not impacts; a vertex deeper than that at the start is an old overlap left to
      * stabilisation. */
@@ -242,8 +241,13 @@ static int crossings_one_way(const lc_world *w, const double *s0, const double *
 int lc_find_crossings(const lc_world *w, const double *s0, const double *s1, int a, int b,
                       lc_buf *buf, int count)
 {
+    frame fa0, fb0, fa1, fb1;
     if (w->is_static[a] && w->is_static[b]) return count;
-    count = crossings_one_way(w, s0, s1, a, b, buf, count);
+    fa0 = frame_of(s0, a);
+    fb0 = frame_of(s0, b);
+    fa1 = frame_of(s1, a);
+    fb1 = frame_of(s1, b);
+    count = crossings_one_way(w, a, b, fa0, fb0, fa1, fb1, buf, count);
     if (count < 0) return count;
-    return crossings_one_way(w, s0, s1, b, a, buf, count);
+    return crossings_one_way(w, b, a, fb0, fa0, fb1, fa1, buf, count);
 }
