@@ -4,46 +4,9 @@
 #include <string.h>
 #include "world.h"
 
-/* Delta relative velocity along di at touch i per unit impulse along dj at touch j (or acceleration
- * per unit force): the J M^-1 J^T entry of the two rows. */
-static double response_dir(const lc_world *w, const lc_touch *ti, lc_vec2 di, const lc_touch *tj, lc_vec2 dj)
-{
-    double sum = 0.0;
-    int bodies_i[2], bodies_j[2], x, y;
-    bodies_i[0] = ti->a; bodies_i[1] = ti->b;
-    bodies_j[0] = tj->a; bodies_j[1] = tj->b;
-    for (x = 0; x < 2; ++x) {
-        int body = bodies_i[x];
-        double si = x == 0 ? 1.0 : -1.0;
-        lc_vec2 ri = x == 0 ? ti->ra : ti->rb;
-        if (w->is_static[body]) continue;
-        for (y = 0; y < 2; ++y) {
-            double sj = y == 0 ? 1.0 : -1.0;
-            lc_vec2 rj = y == 0 ? tj->ra : tj->rb;
-            if (bodies_j[y] != body) continue;
-            sum += si * sj * (lc_dot(di, dj) * w->inv_mass[body] +
-                              lc_cross(ri, di) * lc_cross(rj, dj) * w->inv_inertia[body]);
-        }
-    }
-    return sum;
-}
-
 static double response(const lc_world *w, const lc_touch *ti, const lc_touch *tj)
 {
-    return response_dir(w, ti, ti->n, tj, tj->n);
-}
-
-static lc_vec2 tangent_of(lc_vec2 n) { return lc_v(-n.y, n.x); }
-
-void lc_response_matrix(const lc_world *w, const lc_touch *t, int n, double *A)
-{
-    int i, j;
-    for (i = 0; i < n; ++i)
-        for (j = i; j < n; ++j) {
-            double v = response(w, &t[i], &t[j]);
-            A[i * n + j] = v;
-            A[j * n + i] = v;
-        }
+    return lc_response_dir(w, ti, ti->n, tj, tj->n);
 }
 
 /* Union-find over body rows; static bodies never join groups (they do not transmit motion). */
@@ -80,21 +43,7 @@ static double tangential_velocity(const double *state, const lc_touch *t)
     const double *sa = &state[t->a * 6], *sb = &state[t->b * 6];
     lc_vec2 va = lc_add(lc_v(sa[SVX], sa[SVY]), lc_wcross(sa[SW], t->ra));
     lc_vec2 vb = lc_add(lc_v(sb[SVX], sb[SVY]), lc_wcross(sb[SW], t->rb));
-    return lc_dot(tangent_of(t->n), lc_sub(va, vb));
-}
-
-static void apply_force(const lc_world *w, const lc_touch *t, lc_vec2 F, double *acc)
-{
-    if (!w->is_static[t->a]) {
-        acc[t->a * 3 + 0] += F.x * w->inv_mass[t->a];
-        acc[t->a * 3 + 1] += F.y * w->inv_mass[t->a];
-        acc[t->a * 3 + 2] += lc_cross(t->ra, F) * w->inv_inertia[t->a];
-    }
-    if (!w->is_static[t->b]) {
-        acc[t->b * 3 + 0] -= F.x * w->inv_mass[t->b];
-        acc[t->b * 3 + 1] -= F.y * w->inv_mass[t->b];
-        acc[t->b * 3 + 2] -= lc_cross(t->rb, F) * w->inv_inertia[t->b];
-    }
+    return lc_dot(lc_tangent_of(t->n), lc_sub(va, vb));
 }
 
 /* Normal and Coulomb friction forces for a group with friction: rows 0..m-1 normal (f >= 0), rows
@@ -113,17 +62,17 @@ static int solve_with_friction(lc_world *w, const double *state, lc_touch *sub, 
     mu = f + n2;
     for (i = 0; i < n2; ++i) {
         const lc_touch *ti = &sub[i % m];
-        lc_vec2 di = i < m ? ti->n : tangent_of(ti->n);
+        lc_vec2 di = i < m ? ti->n : lc_tangent_of(ti->n);
         for (j = 0; j < n2; ++j) {
             const lc_touch *tj = &sub[j % m];
-            A[i * n2 + j] = response_dir(w, ti, di, tj, j < m ? tj->n : tangent_of(tj->n));
+            A[i * n2 + j] = lc_response_dir(w, ti, di, tj, j < m ? tj->n : lc_tangent_of(tj->n));
         }
         if (i < m) {
             b[i] = free_acceleration(w, state, ti, acc, ti->n) + kv * ti->vn + kd * (ti->gap - w->def.contact_gap);
             coupled[i] = -1;
             mu[i] = 0.0;
         } else {
-            b[i] = free_acceleration(w, state, ti, acc, tangent_of(ti->n)) + tangential_velocity(state, ti) / h;
+            b[i] = free_acceleration(w, state, ti, acc, lc_tangent_of(ti->n)) + tangential_velocity(state, ti) / h;
             coupled[i] = i - m;
             mu[i] = ti->friction;
         }
@@ -139,7 +88,7 @@ static int solve_with_friction(lc_world *w, const double *state, lc_touch *sub, 
         double ft = isfinite(f[m + i]) ? f[m + i] : 0.0;
         sub[i].value = fn;
         sub[i].tangent = ft;
-        apply_force(w, &sub[i], lc_add(lc_scale(sub[i].n, fn), lc_scale(tangent_of(sub[i].n), ft)), acc);
+        lc_touch_apply(w, &sub[i], lc_add(lc_scale(sub[i].n, fn), lc_scale(lc_tangent_of(sub[i].n), ft)), acc, 3);
     }
     return 0;
 }
@@ -160,19 +109,7 @@ static int solve_sparse(lc_world *w, lc_touch *t, int m, const double *b, double
         /* warm start from the force this touch carried last time */
         f[i] = ti->value > 0.0 && isfinite(ti->value) ? ti->value : 0.0;
         if (fabs(b[i]) > bmax) bmax = fabs(b[i]);
-        if (f[i] > 0.0) {
-            lc_vec2 F = lc_scale(ti->n, f[i]);
-            if (!w->is_static[ti->a]) {
-                dacc[ti->a * 3 + 0] += F.x * w->inv_mass[ti->a];
-                dacc[ti->a * 3 + 1] += F.y * w->inv_mass[ti->a];
-                dacc[ti->a * 3 + 2] += lc_cross(ti->ra, F) * w->inv_inertia[ti->a];
-            }
-            if (!w->is_static[ti->b]) {
-                dacc[ti->b * 3 + 0] -= F.x * w->inv_mass[ti->b];
-                dacc[ti->b * 3 + 1] -= F.y * w->inv_mass[ti->b];
-                dacc[ti->b * 3 + 2] -= lc_cross(ti->rb, F) * w->inv_inertia[ti->b];
-            }
-        }
+        if (f[i] > 0.0) lc_touch_apply(w, ti, lc_scale(ti->n, f[i]), dacc, 3);
     }
     for (sweep = 1; sweep <= w->def.lcp_max_iterations; ++sweep) {
         worst = 0.0;
@@ -194,19 +131,7 @@ static int solve_sparse(lc_world *w, lc_touch *t, int m, const double *b, double
             if (fn < 0.0) fn = 0.0;
             df = fn - f[i];
             f[i] = fn;
-            if (df != 0.0) {
-                lc_vec2 F = lc_scale(ti->n, df);
-                if (!w->is_static[ti->a]) {
-                    dacc[ti->a * 3 + 0] += F.x * w->inv_mass[ti->a];
-                    dacc[ti->a * 3 + 1] += F.y * w->inv_mass[ti->a];
-                    dacc[ti->a * 3 + 2] += lc_cross(ti->ra, F) * w->inv_inertia[ti->a];
-                }
-                if (!w->is_static[ti->b]) {
-                    dacc[ti->b * 3 + 0] -= F.x * w->inv_mass[ti->b];
-                    dacc[ti->b * 3 + 1] -= F.y * w->inv_mass[ti->b];
-                    dacc[ti->b * 3 + 2] -= lc_cross(ti->rb, F) * w->inv_inertia[ti->b];
-                }
-            }
+            if (df != 0.0) lc_touch_apply(w, ti, lc_scale(ti->n, df), dacc, 3);
         }
         if (worst <= w->def.lcp_tolerance * (bmax + 1e-300)) break;
     }
@@ -308,7 +233,7 @@ int lc_contact_forces(lc_world *w, const double *state, lc_touch *touches, int n
             double fj = f[j] > 0.0 && isfinite(f[j]) ? f[j] : 0.0;
             t->value = fj;
             t->tangent = 0.0;
-            apply_force(w, t, lc_scale(t->n, fj), acc);
+            lc_touch_apply(w, t, lc_scale(t->n, fj), acc, 3);
         }
         g0 = g1;
     }

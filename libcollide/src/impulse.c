@@ -13,44 +13,6 @@ static double normal_velocity(const double *state, const lc_touch *t)
     return lc_dot(t->n, lc_sub(va, vb));
 }
 
-static void apply_impulse(const lc_world *w, double *state, const lc_touch *t, lc_vec2 J)
-{
-    if (!w->is_static[t->a]) {
-        double *s = &state[t->a * 6];
-        s[SVX] += J.x * w->inv_mass[t->a];
-        s[SVY] += J.y * w->inv_mass[t->a];
-        s[SW] += lc_cross(t->ra, J) * w->inv_inertia[t->a];
-    }
-    if (!w->is_static[t->b]) {
-        double *s = &state[t->b * 6];
-        s[SVX] -= J.x * w->inv_mass[t->b];
-        s[SVY] -= J.y * w->inv_mass[t->b];
-        s[SW] -= lc_cross(t->rb, J) * w->inv_inertia[t->b];
-    }
-}
-
-static lc_vec2 tangent_of(lc_vec2 n) { return lc_v(-n.y, n.x); }
-
-/* The response of a velocity along di at touch i to a unit impulse along dj at touch j. */
-static double response_dir(const lc_world *w, const lc_touch *ti, lc_vec2 di, const lc_touch *tj, lc_vec2 dj)
-{
-    double sum = 0.0;
-    int bi[2], bj[2], x, y;
-    bi[0] = ti->a; bi[1] = ti->b;
-    bj[0] = tj->a; bj[1] = tj->b;
-    for (x = 0; x < 2; ++x) {
-        lc_vec2 ri = x == 0 ? ti->ra : ti->rb;
-        if (w->is_static[bi[x]]) continue;
-        for (y = 0; y < 2; ++y) {
-            lc_vec2 rj = y == 0 ? tj->ra : tj->rb;
-            if (bj[y] != bi[x]) continue;
-            sum += (x == y ? 1.0 : -1.0) * (lc_dot(di, dj) * w->inv_mass[bi[x]] +
-                                            lc_cross(ri, di) * lc_cross(rj, dj) * w->inv_inertia[bi[x]]);
-        }
-    }
-    return sum;
-}
-
 /* Impacts with Coulomb friction: normal rows a = A j + b >= 0 as without friction, tangent rows aim
  * to stop the sliding, bounded by |j_t| <= mu j_n (boxed complementarity, projected Gauss-Seidel). */
 static int solve_block_friction(lc_world *w, double *state, lc_touch *t, int n, const double *bn,
@@ -69,10 +31,10 @@ static int solve_block_friction(lc_world *w, double *state, lc_touch *t, int n, 
     o.max_iterations = o.max_iterations > 1000 ? o.max_iterations : 1000;
     for (i = 0; i < n2; ++i) {
         const lc_touch *ti = &t[i % n];
-        lc_vec2 di = i < n ? ti->n : tangent_of(ti->n);
+        lc_vec2 di = i < n ? ti->n : lc_tangent_of(ti->n);
         for (k = 0; k < n2; ++k) {
             const lc_touch *tk = &t[k % n];
-            A[i * n2 + k] = response_dir(w, ti, di, tk, k < n ? tk->n : tangent_of(tk->n));
+            A[i * n2 + k] = lc_response_dir(w, ti, di, tk, k < n ? tk->n : lc_tangent_of(tk->n));
         }
         if (i < n) {
             b[i] = bn[i];
@@ -94,7 +56,7 @@ static int solve_block_friction(lc_world *w, double *state, lc_touch *t, int n, 
         double jn = j[i] > 0.0 && isfinite(j[i]) ? j[i] : 0.0;
         double jt = isfinite(j[n + i]) ? j[n + i] : 0.0;
         if (jn <= 0.0) continue;
-        apply_impulse(w, state, &t[i], lc_add(lc_scale(t[i].n, jn), lc_scale(tangent_of(t[i].n), jt)));
+        lc_touch_apply(w, &t[i], lc_add(lc_scale(t[i].n, jn), lc_scale(lc_tangent_of(t[i].n), jt)), state + 3, 6);
         t[i].value += jn;
         t[i].tangent += jt;
         hits++;
@@ -143,7 +105,7 @@ static int solve_block(lc_world *w, double *state, lc_touch *t, int n, int use_e
     for (i = 0; i < n; ++i) {
         double ji = j[i] > 0.0 && isfinite(j[i]) ? j[i] : 0.0;
         if (ji <= 0.0) continue;
-        apply_impulse(w, state, &t[i], lc_scale(t[i].n, ji));
+        lc_touch_apply(w, &t[i], lc_scale(t[i].n, ji), state + 3, 6);
         t[i].value += ji;
         hits++;
     }

@@ -256,20 +256,7 @@ static int project_positions(lc_world *w)
     lc_lcp_solve(n, A, b, lam, NULL, &opt, w->lcp, &res);
     for (i = 0; i < n; ++i) {
         double l = lam[i] > 0.0 && isfinite(lam[i]) ? lam[i] : 0.0;
-        lc_vec2 d = lc_scale(t[i].n, l);
-        if (l == 0.0) continue;
-        if (!w->is_static[t[i].a]) {
-            double *s = &w->state[t[i].a * 6];
-            s[SX] += d.x * w->inv_mass[t[i].a];
-            s[SY] += d.y * w->inv_mass[t[i].a];
-            s[SA] += lc_cross(t[i].ra, d) * w->inv_inertia[t[i].a];
-        }
-        if (!w->is_static[t[i].b]) {
-            double *s = &w->state[t[i].b * 6];
-            s[SX] -= d.x * w->inv_mass[t[i].b];
-            s[SY] -= d.y * w->inv_mass[t[i].b];
-            s[SA] -= lc_cross(t[i].rb, d) * w->inv_inertia[t[i].b];
-        }
+        if (l > 0.0) lc_touch_apply(w, &t[i], lc_scale(t[i].n, l), w->state, 6);
     }
     w->last.position_projections++;
     return 0;

@@ -137,12 +137,21 @@ double lc_vertex_edge_gap(const lc_world *w, const double *state, int a, int ver
  * grown by margin, overlap. Writes pairs as int[2] into buf; returns count or -1. */
 int lc_broad_phase(lc_world *w, const double *s0, const double *s1, double margin, lc_buf *buf);
 
+/* ---- response.c ---- */
+/* Change of relative velocity along di at touch ti per unit impulse along dj at touch tj (J M^-1 J^T). */
+double lc_response_dir(const lc_world *w, const lc_touch *ti, lc_vec2 di, const lc_touch *tj, lc_vec2 dj);
+/* The n x n matrix of normal responses (delta normal velocity at i per unit normal impulse at j). */
+void lc_response_matrix(const lc_world *w, const lc_touch *t, int n, double *A);
+/* Adds push/m and (r x push)/I to body a's three entries at dst[row * stride] and subtracts them from
+ * body b's: velocities (dst = state + 3, stride 6), accelerations (stride 3) or positions (stride 6). */
+void lc_touch_apply(const lc_world *w, const lc_touch *t, lc_vec2 push, double *dst, int stride);
+/* Tangent of a contact normal (the direction of friction rows and tangent impulses). */
+static inline lc_vec2 lc_tangent_of(lc_vec2 n) { return lc_v(-n.y, n.x); }
+
 /* ---- contact_forces.c ---- */
 /* Adds resting contact forces for touches[0..n) into acc (rows indexed), solving the contact LCP.
  * Stores each force in touches[i].value. Returns 0, or -1 on allocation failure. */
 int lc_contact_forces(lc_world *w, const double *state, lc_touch *touches, int n, double *acc);
-/* Builds the n x n matrix of normal responses (delta normal velocity at i per unit impulse at j). */
-void lc_response_matrix(const lc_world *w, const lc_touch *t, int n, double *A);
 
 /* ---- integrator.c ---- */
 /* Advances rows (dynamic bodies) from s0 by h into s1 with the world integrator, touches held as resting
