@@ -47,19 +47,29 @@ static double tangential_velocity(const double *state, const lc_touch *t)
 }
 
 /* Normal and Coulomb friction forces for a group with friction: rows 0..m-1 normal (f >= 0), rows
- * m..2m-1 tangent with |f_t| <= mu f_n, the tangent target being to stop sliding within h. */
+ * m..2m-1 tangent with |f_t| <= mu f_n, the tangent target being to stop sliding within h. Solved by
+ * alternating an exact normal solve (friction held fixed) with a boxed solve of the tangent rows
+ * (normal forces held fixed): a resting pile, where friction is nearly zero, then gets the exact
+ * normal forces, which an all-rows Gauss-Seidel approaches only slowly. */
 static int solve_with_friction(lc_world *w, const double *state, lc_touch *sub, int m, double *acc,
                                double kv, double kd, double h, const lc_lcp_options *opt)
 {
-    int n2 = 2 * m, i, j;
+    int n2 = 2 * m, i, j, outer;
     double *A = lc_buf_get(&w->b_mat, (size_t)n2 * (size_t)n2 * sizeof(double));
-    double *b = lc_buf_get(&w->b_vec, (size_t)n2 * 4 * sizeof(double));
-    int *coupled = lc_buf_get(&w->b_order, (size_t)n2 * sizeof(int));
-    double *f, *mu;
+    double *b = lc_buf_get(&w->b_vec, (size_t)n2 * 8 * sizeof(double));
+    double *f, *Ann, *Att, *bn, *bt, *lo, *hi, *fold;
     lc_lcp_result res;
-    if (!A || !b || !coupled) return -1;
-    f = b + n2;
-    mu = f + n2;
+    lc_lcp_options topt = *opt;
+    if (!A || !b) return -1;
+    f = b + n2;              /* normal forces then tangent forces */
+    bn = f + n2;             /* per-subproblem right-hand sides (m each) */
+    bt = bn + m;
+    lo = bt + m;
+    hi = lo + m;
+    fold = hi + m;
+    Ann = lc_buf_get(&w->b_cfric, (size_t)m * (size_t)m * 2 * sizeof(double));
+    if (!Ann) return -1;
+    Att = Ann + (size_t)m * (size_t)m;
     for (i = 0; i < n2; ++i) {
         const lc_touch *ti = &sub[i % m];
         lc_vec2 di = i < m ? ti->n : lc_tangent_of(ti->n);
@@ -67,20 +77,47 @@ static int solve_with_friction(lc_world *w, const double *state, lc_touch *sub, 
             const lc_touch *tj = &sub[j % m];
             A[i * n2 + j] = lc_response_dir(w, ti, di, tj, j < m ? tj->n : lc_tangent_of(tj->n));
         }
-        if (i < m) {
+        if (i < m)
             b[i] = free_acceleration(w, state, ti, acc, ti->n) + kv * ti->vn + kd * (ti->gap - w->def.contact_gap);
-            coupled[i] = -1;
-            mu[i] = 0.0;
-        } else {
+        else
             b[i] = free_acceleration(w, state, ti, acc, lc_tangent_of(ti->n)) + tangential_velocity(state, ti) / h;
-            coupled[i] = i - m;
-            mu[i] = ti->friction;
-        }
-        f[i] = 0.0;
+        f[i] = i < m ? 0.0 : (isfinite(ti->tangent) ? ti->tangent : 0.0);
     }
-    lc_lcp_solve_boxed(n2, A, b, NULL, NULL, coupled, mu, f, NULL, opt, w->lcp, &res);
+    for (i = 0; i < m; ++i)
+        for (j = 0; j < m; ++j) {
+            Ann[i * m + j] = A[i * n2 + j];
+            Att[i * m + j] = A[(m + i) * n2 + (m + j)];
+        }
+    topt.exact_max = -1;     /* the boxed rows are always iterative */
+    for (outer = 0; outer < 8; ++outer) {
+        double change = 0.0, scale = 0.0;
+        for (i = 0; i < m; ++i) {
+            bn[i] = b[i];
+            for (j = 0; j < m; ++j) bn[i] += A[i * n2 + (m + j)] * f[m + j];
+            fold[i] = f[i];
+        }
+        lc_lcp_solve(m, Ann, bn, f, NULL, opt, w->lcp, &res);
+        w->last.contact_solve_iterations += (uint64_t)res.iterations;
+        for (i = 0; i < m; ++i) {
+            double fn = f[i] > 0.0 && isfinite(f[i]) ? f[i] : 0.0;
+            bt[i] = b[m + i];
+            for (j = 0; j < m; ++j) bt[i] += A[(m + i) * n2 + j] * (f[j] > 0.0 ? f[j] : 0.0);
+            hi[i] = sub[i].friction * fn;
+            lo[i] = -hi[i];
+            if (f[m + i] > hi[i]) f[m + i] = hi[i];
+            if (f[m + i] < lo[i]) f[m + i] = lo[i];
+            fold[i] = fabs(fold[i] - f[i]);
+        }
+        topt.warm_start = 1;
+        lc_lcp_solve_boxed(m, Att, bt, lo, hi, NULL, NULL, f + m, NULL, &topt, w->lcp, &res);
+        w->last.contact_solve_iterations += (uint64_t)res.iterations;
+        for (i = 0; i < m; ++i) {
+            change = fmax(change, fold[i]);
+            scale = fmax(scale, fabs(f[i]));
+        }
+        if (outer > 0 && change <= 1e-10 * (scale + 1e-300)) break;
+    }
     w->last.contact_solves++;
-    w->last.contact_solve_iterations += (uint64_t)res.iterations;
     w->last.resting_contacts += (uint64_t)m;
     if (res.residual > w->last.max_lcp_residual) w->last.max_lcp_residual = res.residual;
     for (i = 0; i < m; ++i) {

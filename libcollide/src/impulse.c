@@ -20,7 +20,7 @@ static int solve_block_friction(lc_world *w, double *state, lc_touch *t, int n, 
 {
     int n2 = 2 * n, i, k, hits = 0;
     double *A = lc_buf_get(&w->b_mat, (size_t)n2 * (size_t)n2 * sizeof(double));
-    double *b = lc_buf_get(&w->b_vec3, (size_t)n2 * 3 * sizeof(double));
+    double *b = lc_buf_get(&w->b_fric, (size_t)n2 * 3 * sizeof(double));
     int *coupled = lc_buf_get(&w->b_order, (size_t)n2 * sizeof(int));
     double *j, *mu;
     lc_lcp_options o = *opt;

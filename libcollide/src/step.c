@@ -57,10 +57,12 @@ static int warm_start(lc_world *w, lc_touch *t, int n)
     for (i = 0; i < n; ++i) {
         uint32_t k = touch_key(w, &t[i]) & (uint32_t)(size - 1);
         t[i].value = 0.0;
+        t[i].tangent = 0.0;
         while (table[k] >= 0) {
             const lc_touch *o = &old[table[k]];
             if (o->a == t[i].a && o->b == t[i].b && o->vertex == t[i].vertex && o->edge == t[i].edge) {
                 t[i].value = o->value;
+                t[i].tangent = o->tangent;
                 break;
             }
             k = (k + 1) & (uint32_t)(size - 1);
@@ -287,7 +289,7 @@ lc_status lc_world_step(lc_world *w, double dt)
     backup = lc_buf_get(&w->b_backup, bytes);
     s0 = lc_buf_get(&w->b_state0, bytes);
     s1 = lc_buf_get(&w->b_state1, bytes);
-    scratch = lc_buf_get(&w->b_vec3, bytes);
+    scratch = lc_buf_get(&w->b_step_scratch, bytes);
     rows = lc_buf_get(&w->b_rows, (size_t)(w->count > 0 ? w->count : 1) * sizeof(int));
     if (!backup || !s0 || !s1 || !scratch || !rows) return lc_fail(w, LC_ERR_NO_MEMORY, "out of memory in step");
     memcpy(backup, w->state, (size_t)w->count * 6 * sizeof(double));

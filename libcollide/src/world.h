@@ -83,7 +83,10 @@ struct lc_world {
     /* scratch, reused between steps */
     lc_lcp_workspace *lcp;
     lc_buf b_state0, b_state1, b_backup, b_k[4], b_tmp, b_acc;
-    lc_buf b_touch, b_rest, b_pairs, b_aabb, b_rows, b_island, b_flags, b_mat, b_vec, b_vec2, b_vec3, b_order;
+    lc_buf b_touch, b_rest, b_pairs, b_aabb, b_rows, b_island, b_flags, b_mat, b_vec, b_vec2, b_order;
+    lc_buf b_step_scratch;   /* step.c only: held across the whole step, so no other file may use it */
+    lc_buf b_fric;           /* impulse.c: friction rows of an impact */
+    lc_buf b_cfric;          /* contact_forces.c: normal and tangent blocks of a friction group */
     lc_buf b_cross, b_impact, b_irows, b_coupled, b_dacc, b_diag, b_warm, b_hash;
     int warm_count;          /* resting touches kept in b_warm from the previous pass (warm start) */
     double step_dt;          /* dt of the step in progress (stabilisation time scale) */
