@@ -1,0 +1,350 @@
+"""libcollide against Box2D v3 (pyb2d3), Chipmunk2D (pymunk) and Box2D 2.3 (pybox2d): speed against
+error on the issue-4 scenes. Use bench/run (it installs bench/requirements.txt first).
+
+    bench/run [--quick | --full] [--sections wp,impacts,cradle,stacks,pyramid,tunnel,scaling]
+
+Writes docs/benchmarks.md, docs/img/bench_*.png and bench/results/latest.json."""
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import platform
+import sys
+import time
+from typing import Any
+
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)
+
+import harness  # noqa: E402
+import metrics  # noqa: E402
+import report  # noqa: E402
+import scenes  # noqa: E402
+from harness import Task  # noqa: E402
+
+ROOT = os.path.dirname(HERE)
+PEERS = ("pymunk", "box2d3", "box2d2")
+ALL = ("libcollide",) + PEERS
+DTS = (1 / 60, 1 / 120, 1 / 240, 1 / 960)
+
+# Work-precision settings per engine: (label, settings, dts). Peers at their defaults plus the fair
+# settings of bench/engines/*.py; the variants move each engine's own accuracy knob.
+WP_VARIANTS: dict[str, list[tuple[str, dict, tuple[float, ...]]]] = {
+    "libcollide": [("libcollide", {}, DTS),
+                   ("libcollide tol 1e-6", {"toi_time_tolerance": 1e-6, "toi_distance_tolerance": 1e-8}, DTS[:1]),
+                   ("libcollide tol 1e-3", {"toi_time_tolerance": 1e-3, "toi_distance_tolerance": 1e-4,
+                                            "contact_gap": 1e-3, "contact_distance": 1e-2}, DTS[:1])],
+    "pymunk": [("pymunk", {}, DTS), ("pymunk 30 it", {"iterations": 30}, DTS[:1] + DTS[2:3])],
+    "box2d3": [("box2d3", {}, DTS), ("box2d3 1 sub", {"substeps": 1}, DTS[:1]),
+               ("box2d3 8 sub", {"substeps": 8}, DTS[:1])],
+    "box2d2": [("box2d2", {}, DTS), ("box2d2 20/10 it", {"velocity_iterations": 20, "position_iterations": 10},
+                                     DTS[:1])],
+}
+
+
+def log(msg: str) -> None:
+    print(f"[{time.strftime('%H:%M:%S')}] {msg}", flush=True)
+
+
+def strip(res: dict[str, Any]) -> dict[str, Any]:
+    """JSON-able copy without the bulky state arrays."""
+    return {k: v for k, v in res.items() if k not in ("states", "times", "trace")}
+
+
+class Bench:
+    def __init__(self, args: argparse.Namespace) -> None:
+        self.args = args
+        self.quick = args.quick
+        self.full = args.full
+        self.repeats = 1 if args.quick else (5 if args.full else 3)
+        self.budget = args.budget or (4.0 if args.quick else (60.0 if args.full else 15.0))
+        self.pool = harness.Pool()
+        self.out: dict[str, Any] = {}
+
+    def run(self, tasks: list[Task], repeats: int | None = None) -> dict[str, dict[str, Any]]:
+        return harness.run_interleaved(self.pool, tasks, self.repeats if repeats is None else repeats, log)
+
+    # ---- (1) seed scene: work-precision --------------------------------------------------------
+    def wp(self) -> None:
+        seeds = (1,) if self.quick else (1, 2, 3)
+        gs = (0.0, 9.8)
+        out: dict[str, Any] = {}
+        for g in gs:
+            tasks = []
+            for sd in seeds:
+                sc = scenes.seed(20, g, sd)
+                # interleave engines: case by case, every engine's variant in turn
+                for dt in DTS[:2] if self.quick else DTS:
+                    for eng in ALL:
+                        for label, settings, dts in WP_VARIANTS[eng]:
+                            if dt in dts and (not self.quick or label == eng):
+                                tasks.append(Task(eng, sc, dt, settings, None, self.budget, label))
+            log(f"seed scene g={g}: {len(tasks)} runs x {self.repeats}")
+            res = self.run(tasks)
+            pts: dict[str, list[dict[str, Any]]] = {}
+            for r in res.values():
+                sc = scenes.seed(20, g, int(r["scene"].rsplit("_s", 1)[1]))
+                m = metrics.seed_metrics(sc, r) if r.get("status") == "ok" and metrics.finite(r) else {}
+                pts.setdefault(f"{r['label']}|{r['dt']!r}", []).append({**strip(r), **m})
+            rows = []
+            for key, runs in pts.items():
+                label, dt = key.split("|")
+                ok = [x for x in runs if "drift" in x]
+                rows.append({"label": label, "engine": runs[0]["engine"], "dt": float(dt), "runs": len(runs),
+                             "failed": [x["status"] for x in runs if "drift" not in x],
+                             "drift": float(np.median([x["drift"] for x in ok])) if ok else math.nan,
+                             "drifts": [x["drift"] for x in ok],
+                             "abs_drift": float(np.median([abs(x["drift"]) for x in ok])) if ok else math.nan,
+                             "max_abs_drift": float(np.median([x["max_abs_drift"] for x in ok])) if ok else math.nan,
+                             "escaped": int(sum(x["escaped"] for x in ok)),
+                             "cost": float(np.median([x["cpu_per_sim_s"] for x in runs if "cpu_per_sim_s" in x])),
+                             "us_per_step": float(np.median([x["us_per_step"] for x in runs if "us_per_step" in x])),
+                             "stages": runs[0].get("stages", {})})
+            out[f"g{g:g}"] = rows
+        # N = 6 at dt 1/60, g = 0 and 9.8 (the seed page's block count)
+        tasks = [Task(eng, scenes.seed(6, g, sd), 1 / 60, {}, None, self.budget) for g in gs for sd in seeds
+                 for eng in ALL]
+        res = self.run(tasks)
+        six = []
+        for r in res.values():
+            g = float(r["scene"].split("_g")[1].split("_")[0])
+            sc = scenes.seed(6, g, int(r["scene"].rsplit("_s", 1)[1]))
+            m = metrics.seed_metrics(sc, r) if r.get("status") == "ok" and metrics.finite(r) else {}
+            six.append({**strip(r), **m, "g": g})
+        out["n6"] = six
+        self.out["wp"] = out
+
+    # ---- single impacts and the flat drop ------------------------------------------------------
+    def impacts(self) -> None:
+        cases = [(scenes.wall_hit(3.0, 0.0), (1 / 60, 1 / 240)), (scenes.wall_hit(3.0, math.radians(30)), (1 / 60,)),
+                 (scenes.flat_drop(), (1 / 60, 1 / 240))]
+        tasks = [Task(eng, sc, dt, {}, None, self.budget) for sc, dts in cases for dt in dts for eng in ALL]
+        log(f"impacts: {len(tasks)} runs")
+        res = self.run(tasks)
+        rows = []
+        for r in res.values():
+            sc = next(sc for sc, _ in cases if sc.name == r["scene"])
+            m = metrics.impact_metrics(sc, r) if r.get("status") == "ok" and metrics.finite(r) else {}
+            rows.append({**strip(r), **m})
+        self.out["impacts"] = rows
+
+    # ---- (5) Newton's cradle -------------------------------------------------------------------
+    def cradle(self) -> None:
+        cases = [scenes.cradle(0.0), scenes.cradle(0.05)]
+        tasks = [Task(eng, sc, 1 / 60, {}, None, self.budget) for sc in cases for eng in ALL]
+        tasks += [Task("pymunk", sc, 1 / 60, {"iterations": 30}, None, self.budget, "pymunk 30 it") for sc in cases]
+        log(f"cradle: {len(tasks)} runs")
+        res = self.run(tasks)
+        rows = []
+        for r in res.values():
+            sc = next(sc for sc in cases if sc.name == r["scene"])
+            m = metrics.cradle_metrics(sc, r) if r.get("status") == "ok" and metrics.finite(r) else {}
+            rows.append({**strip(r), **m})
+        self.out["cradle"] = rows
+
+    # ---- (3) stacks ----------------------------------------------------------------------------
+    def stacks(self) -> None:
+        cases = [(scenes.stack(10), (1 / 60, 1 / 240)), (scenes.stack(10, e=1.0), (1 / 60,)),
+                 (scenes.stack(20), (1 / 60, 1 / 240))]
+        if self.quick:
+            cases = [(scenes.stack(10), (1 / 60,)), (scenes.stack(10, e=1.0), (1 / 60,))]
+        tasks = []
+        for sc, dts in cases:
+            for dt in dts:
+                for eng in ALL:
+                    if eng == "libcollide" and dt != 1 / 60:
+                        continue   # event-driven: dt is only the output interval
+                    tasks.append(Task(eng, sc, dt, {}, 1 / 60, self.budget))
+                if sc.e == 1.0:
+                    tasks.append(Task("box2d3", sc, dt, {"restitution_threshold": 1.0}, 1 / 60, self.budget,
+                                      "box2d3 thr 1 m/s"))
+        log(f"stacks: {len(tasks)} runs")
+        res = self.run(tasks, repeats=1 if not self.full else 3)
+        rows = []
+        for r in res.values():
+            sc = next(sc for sc, _ in cases if sc.name == r["scene"])
+            ok = r.get("status") in ("ok", "over_budget") and metrics.finite(r) and r.get("sim_time", 0) > 0
+            m = metrics.stack_metrics(sc, r) if ok else {}
+            rows.append({**strip(r), **m})
+        self.out["stacks"] = rows
+
+    # ---- (4) pyramid ----------------------------------------------------------------------------
+    def pyramid(self) -> None:
+        bases = (5, 20) if self.quick else ((5, 20, 50, 100) if self.full else (5, 20, 50))
+        rows = []
+        failed: set[str] = set()
+        for base in bases:
+            sc = scenes.pyramid(base, duration=(100 if self.quick else 500) / 60)
+            tasks = [Task(eng, sc, 1 / 60, {}, None, self.budget * (2 if base > 20 else 1)) for eng in ALL
+                     if eng not in failed]
+            for eng in failed:
+                rows.append({"engine": eng, "label": eng, "scene": sc.name, "dt": 1 / 60, "base": base,
+                             "bodies": len(sc.dynamic), "status": "not run: a smaller base did not finish"})
+            log(f"pyramid base {base}: {len(tasks)} runs")
+            res = self.run(tasks)
+            for r in res.values():
+                ok = r.get("status") in ("ok", "over_budget") and metrics.finite(r) and r.get("sim_time", 0) > 0
+                m = metrics.pyramid_metrics(sc, r) if ok else {}
+                rows.append({**strip(r), **m, "base": base, "bodies": len(sc.dynamic)})
+                if r.get("status") != "ok":
+                    failed.add(r["engine"])
+        self.out["pyramid"] = rows
+
+    # ---- (6) tunnelling -----------------------------------------------------------------------
+    def tunnel(self) -> None:
+        cases = [scenes.tunnel(v) for v in (10.0, 50.0, 200.0)]
+        tasks = [Task(eng, sc, 1 / 60, {}, 1 / 60, self.budget) for sc in cases for eng in ALL]
+        log(f"tunnel: {len(tasks)} runs")
+        res = self.run(tasks, repeats=1)
+        rows = []
+        for r in res.values():
+            sc = next(sc for sc in cases if sc.name == r["scene"])
+            m = metrics.tunnel_metrics(sc, r) if r.get("status") == "ok" and metrics.finite(r) else {}
+            rows.append({**strip(r), **m})
+        self.out["tunnel"] = rows
+
+    # ---- (2), (7), (8), (10): hard cases -------------------------------------------------------
+    def hard(self) -> None:
+        cases = [scenes.settling(), scenes.mass_ratio_stack(), scenes.wedged(), scenes.smash()]
+        if self.quick:
+            cases = [scenes.settling(duration=3.0), scenes.mass_ratio_stack(duration=3.0), scenes.wedged(duration=3.0),
+                     scenes.smash(duration=1.0)]
+        tasks = [Task(eng, sc, 1 / 60, {}, 1 / 60, self.budget) for sc in cases for eng in ALL]
+        log(f"hard cases: {len(tasks)} runs")
+        res = self.run(tasks, repeats=1 if not self.full else 3)
+        rows = []
+        for r in res.values():
+            sc = next(sc for sc in cases if sc.name == r["scene"])
+            ok = r.get("status") in ("ok", "over_budget") and metrics.finite(r) and r.get("sim_time", 0) > 0
+            m = metrics.hard_metrics(sc, r) if ok else {}
+            rows.append({**strip(r), **m})
+        self.out["hard"] = rows
+
+    # ---- scaling ---------------------------------------------------------------------------------
+    def scaling(self) -> None:
+        ns = [6, 20, 50, 100, 200, 500, 1000]
+        if self.quick:
+            ns = [6, 20, 100, 300]
+        else:
+            ns += [2000]
+        if self.full:
+            ns += [5000]
+        # n = 0: one static box only, i.e. the per-step floor of each engine and its Python binding
+        empty = scenes.Scene("many0", (scenes.Box(1.0, 1.0, 0.0, 0.0, static=True),), duration=10.0)
+        tasks = [Task(eng, empty, 1 / 60, {}, None, self.budget) for eng in ALL]
+        tasks += [Task(eng, scenes.many(n), 1 / 60, {}, None, self.budget) for n in ns for eng in ALL]
+        log(f"scaling: {len(tasks)} runs")
+        res = self.run(tasks)
+        rows = []
+        for r in res.values():
+            n = int(r["scene"][4:])
+            m = {}
+            if n and r.get("status") == "ok" and metrics.finite(r):
+                m = metrics.seed_metrics(scenes.many(n), r)
+            rows.append({**strip(r), **m, "n": n})
+        self.out["scaling"] = rows
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    g = ap.add_mutually_exclusive_group()
+    g.add_argument("--quick", action="store_true", help="1-2 minute smoke run (1 seed, 1 repeat, short scenes)")
+    g.add_argument("--full", action="store_true", help="more repeats, larger scenes, longer budgets")
+    ap.add_argument("--sections", default="wp,impacts,cradle,tunnel,stacks,hard,pyramid,scaling")
+    ap.add_argument("--out", default=os.path.join(ROOT, "docs", "benchmarks.md"),
+                    help="markdown file to write; the plots go to img/ next to it")
+    ap.add_argument("--budget", type=float, help="CPU seconds per run before it is stopped (default 15, quick 4, full 60)")
+    ap.add_argument("--no-report", action="store_true", help="only write bench/results/latest.json")
+    args = ap.parse_args()
+    t0 = time.time()
+    b = Bench(args)
+    import importlib.metadata as md
+    b.out["meta"] = {"date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()), "mode":
+                     "quick" if args.quick else ("full" if args.full else "default"),
+                     "repeats": b.repeats, "budget_cpu_s": b.budget, "machine": platform.machine(),
+                     "cpus": os.cpu_count(), "python": platform.python_version(),
+                     "cpu_model": _cpu_model(), "load_before": os.getloadavg(), "libcollide": _lc_build(),
+                     "versions": {p: _ver(md, p) for p in ("pymunk", "pyb2d3", "Box2D", "numpy", "matplotlib")}}
+    try:
+        for sec in args.sections.split(","):
+            getattr(b, sec.strip())()
+    finally:
+        b.pool.close()
+    b.out["meta"]["wall_s"] = time.time() - t0
+    b.out["meta"]["load_after"] = os.getloadavg()
+    os.makedirs(os.path.join(HERE, "results"), exist_ok=True)
+    path = os.path.join(HERE, "results", "latest.json")
+    with open(path, "w") as f:
+        json.dump(b.out, f, indent=1, default=_json)
+    log(f"wrote {path}")
+    if not args.no_report:
+        report.write(b.out, args.out, os.path.join(os.path.dirname(os.path.abspath(args.out)), "img"))
+        log(f"wrote {args.out}")
+    log(f"done in {time.time() - t0:.0f} s")
+    return 0
+
+
+def _lc_build() -> str:
+    """Which libcollide was measured: git HEAD, whether libcollide/ has uncommitted edits, .so time."""
+    import subprocess
+    def git(*a: str) -> str:
+        try:
+            return subprocess.run(["git", "-C", ROOT, *a], capture_output=True, text=True, timeout=20).stdout.strip()
+        except (OSError, subprocess.SubprocessError):
+            return "?"
+    other = os.environ.get("LIBCOLLIDE_BENCH_LIB")
+    if other:   # bench/run --lib DIR
+        so = os.path.join(other, "libcollide.so")
+        src = "?"
+        cache = os.path.join(other, "CMakeCache.txt")
+        if os.path.exists(cache):   # the build's source tree; a COMMIT file there names an exported commit
+            for line in open(cache):
+                if line.startswith("CMAKE_HOME_DIRECTORY:"):
+                    src = line.split("=", 1)[1].strip()
+            commit = os.path.join(src, "COMMIT")
+            if os.path.exists(commit):
+                src += f" = commit {open(commit).read().strip()}"
+            elif src == ROOT:
+                src += f" (commit {git('rev-parse', '--short', 'HEAD')}, working tree)"
+        when = time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime(os.path.getmtime(so)))
+        return f"{so}, sources {src}, built {when}"
+    head = git("rev-parse", "--short", "HEAD")
+    dirty = " + uncommitted edits in libcollide/" if git("status", "--porcelain", "--", "libcollide") else ""
+    so = os.path.join(os.environ.get("LIBCOLLIDE_BUILD_DIR", os.path.join(ROOT, "build")), "libcollide.so")
+    when = time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime(os.path.getmtime(so))) if os.path.exists(so) else "?"
+    return f"commit {head}{dirty}, library built {when}"
+
+
+def _ver(md: Any, p: str) -> str:
+    try:
+        return md.version(p)
+    except md.PackageNotFoundError:
+        return "missing"
+
+
+def _cpu_model() -> str:
+    try:
+        for line in open("/proc/cpuinfo"):
+            if line.startswith("model name"):
+                return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return platform.processor()
+
+
+def _json(o: Any) -> Any:
+    if isinstance(o, np.ndarray):
+        return o.tolist()
+    if isinstance(o, (np.floating, np.integer)):
+        return o.item()
+    if isinstance(o, np.bool_):
+        return bool(o)
+    return str(o)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
