@@ -4,11 +4,6 @@
 #include <string.h>
 #include "world.h"
 
-static double response(const lc_world *w, const lc_touch *ti, const lc_touch *tj)
-{
-    return lc_response_dir(w, ti, ti->n, tj, tj->n);
-}
-
 /* Union-find over body rows; static bodies never join groups (they do not transmit motion). */
 static int find(int *parent, int x)
 {
@@ -131,44 +126,57 @@ static int solve_with_friction(lc_world *w, const double *state, lc_touch *sub, 
 }
 
 /* Projected Gauss-Seidel in body space for groups above lcp_exact_max: the matrix A = J M^-1 J^T is
- * never formed; each sweep costs O(points) instead of O(points^2). Returns sweeps, residual in *res. */
-static int solve_sparse(lc_world *w, lc_touch *t, int m, const double *b, double *f, double *res)
+ * never formed; each sweep costs O(points) instead of O(points^2). With bt != NULL each point also has
+ * a friction row, clamped to the Coulomb cone of its current normal force. Starts from the touches'
+ * previous forces (warm start). Returns sweeps (residual in *res) or -1. */
+static int solve_sparse(lc_world *w, lc_touch *t, int m, const double *b, const double *bt, double *f,
+                        double *ft, double *res)
 {
-    double *diag = lc_buf_get(&w->b_diag, (size_t)m * sizeof(double));
+    double *diag = lc_buf_get(&w->b_diag, (size_t)m * 2 * sizeof(double));
     double *dacc = lc_buf_get(&w->b_dacc, (size_t)w->count * 3 * sizeof(double));
-    double bmax = 0.0, worst = 0.0;
+    double *diag_t, bmax = 0.0, worst = 0.0;
     int i, sweep;
     if (!diag || !dacc) return -1;
+    diag_t = diag + m;
     memset(dacc, 0, (size_t)w->count * 3 * sizeof(double));
     for (i = 0; i < m; ++i) {
         const lc_touch *ti = &t[i];
-        diag[i] = response(w, ti, ti);
-        /* warm start from the force this touch carried last time */
+        lc_vec2 tan = lc_tangent_of(ti->n);
+        diag[i] = lc_response_dir(w, ti, ti->n, ti, ti->n);
         f[i] = ti->value > 0.0 && isfinite(ti->value) ? ti->value : 0.0;
         if (fabs(b[i]) > bmax) bmax = fabs(b[i]);
         if (f[i] > 0.0) lc_touch_apply(w, ti, lc_scale(ti->n, f[i]), dacc, 3);
+        if (bt) {
+            diag_t[i] = lc_response_dir(w, ti, tan, ti, tan);
+            ft[i] = isfinite(ti->tangent) ? ti->tangent : 0.0;
+            if (fabs(ft[i]) > ti->friction * f[i]) ft[i] = ft[i] > 0.0 ? ti->friction * f[i] : -ti->friction * f[i];
+            if (ft[i] != 0.0) lc_touch_apply(w, ti, lc_scale(tan, ft[i]), dacc, 3);
+        }
     }
     for (sweep = 1; sweep <= w->def.lcp_max_iterations; ++sweep) {
         worst = 0.0;
         for (i = 0; i < m; ++i) {
             const lc_touch *ti = &t[i];
-            double a = b[i], fn, df;
-            if (!w->is_static[ti->a]) {
-                const double *d = &dacc[ti->a * 3];
-                a += lc_dot(ti->n, lc_add(lc_v(d[0], d[1]), lc_wcross(d[2], ti->ra)));
-            }
-            if (!w->is_static[ti->b]) {
-                const double *d = &dacc[ti->b * 3];
-                a -= lc_dot(ti->n, lc_add(lc_v(d[0], d[1]), lc_wcross(d[2], ti->rb)));
-            }
-            /* residual of the complementarity conditions before this update */
+            double a = b[i] + lc_response_push(w, ti, ti->n, dacc), fn, df;
             if (fabs(fmin(f[i], a)) > worst) worst = fabs(fmin(f[i], a));
-            if (!(diag[i] > 0.0)) continue;
-            fn = f[i] - a / diag[i];
-            if (fn < 0.0) fn = 0.0;
-            df = fn - f[i];
-            f[i] = fn;
-            if (df != 0.0) lc_touch_apply(w, ti, lc_scale(ti->n, df), dacc, 3);
+            if (diag[i] > 0.0) {
+                fn = f[i] - a / diag[i];
+                if (fn < 0.0) fn = 0.0;
+                df = fn - f[i];
+                f[i] = fn;
+                if (df != 0.0) lc_touch_apply(w, ti, lc_scale(ti->n, df), dacc, 3);
+            }
+            if (bt && diag_t[i] > 0.0) {
+                lc_vec2 tan = lc_tangent_of(ti->n);
+                double at = bt[i] + lc_response_push(w, ti, tan, dacc);
+                double lim = ti->friction * f[i], fnew = ft[i] - at / diag_t[i];
+                if (fnew > lim) fnew = lim;
+                if (fnew < -lim) fnew = -lim;
+                if (fnew != ft[i]) {
+                    lc_touch_apply(w, ti, lc_scale(tan, fnew - ft[i]), dacc, 3);
+                    ft[i] = fnew;
+                }
+            }
         }
         if (worst <= w->def.lcp_tolerance * (bmax + 1e-300)) break;
     }
@@ -232,6 +240,33 @@ int lc_contact_forces(lc_world *w, const double *state, lc_touch *touches, int n
         {
             int with_friction = 0;
             for (j = 0; j < m; ++j) if (sub[j].friction > 0.0) with_friction = 1;
+            if (with_friction && m > w->def.lcp_exact_max) {
+                double resid, *bt = lc_buf_get(&w->b_cfric, (size_t)m * 2 * sizeof(double)), *ft;
+                int sweeps;
+                if (bt == NULL) return -1;
+                ft = bt + m;
+                for (j = 0; j < m; ++j) {
+                    b[j] = free_acceleration(w, state, &sub[j], acc, sub[j].n) + kv * sub[j].vn +
+                           kd * (sub[j].gap - w->def.contact_gap);
+                    bt[j] = free_acceleration(w, state, &sub[j], acc, lc_tangent_of(sub[j].n)) +
+                            tangential_velocity(state, &sub[j]) / h;
+                }
+                sweeps = solve_sparse(w, sub, m, b, bt, f, ft, &resid);
+                if (sweeps < 0) return -1;
+                w->last.contact_solves++;
+                w->last.contact_solve_iterations += (uint64_t)sweeps;
+                w->last.resting_contacts += (uint64_t)m;
+                if (resid > w->last.max_lcp_residual) w->last.max_lcp_residual = resid;
+                for (j = 0; j < m; ++j) {
+                    lc_touch *t = &touches[order[g0 + j]];
+                    double fn = f[j] > 0.0 && isfinite(f[j]) ? f[j] : 0.0, ftj = isfinite(ft[j]) ? ft[j] : 0.0;
+                    t->value = fn;
+                    t->tangent = ftj;
+                    lc_touch_apply(w, t, lc_add(lc_scale(t->n, fn), lc_scale(lc_tangent_of(t->n), ftj)), acc, 3);
+                }
+                g0 = g1;
+                continue;
+            }
             if (with_friction) {
                 if (solve_with_friction(w, state, sub, m, acc, kv, kd, h, &opt) != 0) return -1;
                 for (j = 0; j < m; ++j) {
@@ -248,7 +283,7 @@ int lc_contact_forces(lc_world *w, const double *state, lc_touch *touches, int n
             for (j = 0; j < m; ++j)
                 b[j] = free_acceleration(w, state, &sub[j], acc, sub[j].n) + kv * sub[j].vn +
                        kd * (sub[j].gap - w->def.contact_gap);
-            sweeps = solve_sparse(w, sub, m, b, f, &resid);
+            sweeps = solve_sparse(w, sub, m, b, NULL, f, NULL, &resid);
             if (sweeps < 0) return -1;
             res.iterations = sweeps;
             res.residual = resid;

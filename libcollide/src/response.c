@@ -50,3 +50,17 @@ void lc_touch_apply(const lc_world *w, const lc_touch *t, lc_vec2 push, double *
         d[2] -= lc_cross(t->rb, push) * w->inv_inertia[t->b];
     }
 }
+
+double lc_response_push(const lc_world *w, const lc_touch *t, lc_vec2 d, const double *acc)
+{
+    double v = 0.0;
+    if (!w->is_static[t->a]) {
+        const double *x = &acc[t->a * 3];
+        v += lc_dot(d, lc_add(lc_v(x[0], x[1]), lc_wcross(x[2], t->ra)));
+    }
+    if (!w->is_static[t->b]) {
+        const double *x = &acc[t->b * 3];
+        v -= lc_dot(d, lc_add(lc_v(x[0], x[1]), lc_wcross(x[2], t->rb)));
+    }
+    return v;
+}

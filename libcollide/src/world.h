@@ -148,6 +148,9 @@ void lc_response_matrix(const lc_world *w, const lc_touch *t, int n, double *A);
 /* Adds push/m and (r x push)/I to body a's three entries at dst[row * stride] and subtracts them from
  * body b's: velocities (dst = state + 3, stride 6), accelerations (stride 3) or positions (stride 6). */
 void lc_touch_apply(const lc_world *w, const lc_touch *t, lc_vec2 push, double *dst, int stride);
+/* Relative motion along d at touch t produced by per-body changes acc[row * 3 + 0..2] (the inverse of
+ * lc_touch_apply with stride 3). */
+double lc_response_push(const lc_world *w, const lc_touch *t, lc_vec2 d, const double *acc);
 /* Tangent of a contact normal (the direction of friction rows and tangent impulses). */
 static inline lc_vec2 lc_tangent_of(lc_vec2 n) { return lc_v(-n.y, n.x); }
 
