@@ -137,6 +137,13 @@ static int face_touches(const lc_world *w, const double *state, int inc, int ref
     return count;
 }
 
+double lc_pair_separation(const lc_world *w, const double *state, int a, int b)
+{
+    int ka, kb;
+    double sb = max_separation(w, state, a, b, &kb), sa = max_separation(w, state, b, a, &ka);
+    return sa > sb ? sa : sb;
+}
+
 int lc_collect_touches(const lc_world *w, const double *state, int a, int b, double max_gap,
                        lc_buf *buf, int count)
 {
@@ -213,6 +220,7 @@ static int crossings_one_way(const lc_world *w, int a, int b, frame fa0, frame f
         if (dmax0 < start_tol) continue;          /* started inside */
         if (hit < 0) {
             if (!(dmax1 < start_tol)) continue;   /* ended outside and never crossed an edge */
+            if (deepest < 0) continue;            /* non-finite coordinates: nothing to test */
             hit = deepest;                        /* rotation carried it in: least-penetrated edge */
         } else if (!(dmax1 < start_tol)) {
             /* crossed an edge line but ended outside: only a tunnel if it went through the body,
@@ -232,6 +240,7 @@ static int crossings_one_way(const lc_world *w, int a, int b, frame fa0, frame f
             c[count].vertex = i;
             c[count].edge = hit;
             c[count].toi = 0.0;
+            c[count].t_hi = -1.0;   /* the caller knows the interval */
             count++;
         }
     }

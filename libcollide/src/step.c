@@ -7,6 +7,8 @@
 
 /* Most a body may turn (rad) within one collision-checked interval. */
 #define LC_MAX_TRIAL_ROTATION 0.25
+/* Most rotation-limited intervals in one step. */
+#define LC_MAX_TRIALS 1024
 
 /* Touches between all near pairs at `state` with gap < contact_distance, appended to buf from 0. */
 static int gather_touches(lc_world *w, const double *state, lc_buf *buf)
@@ -264,6 +266,72 @@ static int project_positions(lc_world *w)
     return 0;
 }
 
+/* How far a vertex of one body can stray, in the other's frame, from the straight chord between its
+ * positions at the ends of an interval of length h: turning by dtheta bends the path by r dtheta^2 / 8,
+ * and a velocity change dv by dv h / 8. */
+static double chord_deviation(const lc_world *w, const double *s0, const double *s1, double h, int a, int b)
+{
+    double turn = fabs(s1[a * 6 + SA] - s0[a * 6 + SA]) + fabs(s1[b * 6 + SA] - s0[b * 6 + SA]);
+    double dva = hypot(s1[a * 6 + SVX] - s0[a * 6 + SVX], s1[a * 6 + SVY] - s0[a * 6 + SVY]);
+    double dvb = hypot(s1[b * 6 + SVX] - s0[b * 6 + SVX], s1[b * 6 + SVY] - s0[b * 6 + SVY]);
+    return turn * turn * (w->shape[a].radius + w->shape[b].radius) / 8.0 + (dva + dvb) * h / 8.0;
+}
+
+/* Vertices that dip into another body and come back out within the interval are invisible to the
+ * end-point test. For pairs that end up closer than their chords can stray, the two bodies' motion is
+ * sampled at LC_SWEEP_SAMPLES sub-times and every sub-interval is tested; a crossing found there
+ * carries the sub-time by which it is inside as the upper end of its time-of-impact bracket. */
+#define LC_SWEEP_SAMPLES 8
+static int swept_check(lc_world *w, const double *s0, const double *s1, double h, const int *pairs, int np, int nc,
+                       const int *coupled, const int *all_rows, int n_all, lc_touch *rest, int nrest)
+{
+    size_t bytes = (size_t)w->count * 6 * sizeof(double);
+    int p, k, i;
+    for (p = 0; p < np; ++p) {
+        int a = pairs[2 * p], b = pairs[2 * p + 1], rows[2], nr = 0, have = 0;
+        double dev, sep0, *prev, *cur;
+        for (i = 0; i < nc; ++i) {
+            const lc_crossing *c = &((const lc_crossing *)w->b_cross.p)[i];
+            if ((c->a == a && c->b == b) || (c->a == b && c->b == a)) have = 1;
+        }
+        if (have) continue;   /* the end-point test already bracketed this pair */
+        dev = chord_deviation(w, s0, s1, h, a, b);
+        sep0 = lc_pair_separation(w, s0, a, b);
+        /* touching at the start: resting contacts or impacts already guard the pair */
+        if (sep0 < w->def.contact_distance) continue;
+        if (sep0 > dev + w->def.contact_distance && lc_pair_separation(w, s1, a, b) > dev + w->def.contact_distance)
+            continue;
+        if (!w->is_static[a]) rows[nr++] = a;
+        if (!w->is_static[b]) rows[nr++] = b;
+        prev = lc_buf_get(&w->b_sample0, bytes);
+        cur = lc_buf_get(&w->b_sample1, bytes);
+        if (!prev || !cur) return -1;
+        memcpy(prev, s0, bytes);
+        for (k = 1; k <= LC_SWEEP_SAMPLES; ++k) {
+            double tk = h * k / LC_SWEEP_SAMPLES, *swap;
+            int before = nc;
+            if (k < LC_SWEEP_SAMPLES) {
+                /* a pair in touch with others or joined by a spring moves with them: then the whole
+                 * world is advanced with its resting contacts, exactly as in the trial */
+                int uncoupled = !coupled[a] && !coupled[b];
+                if (lc_integrate(w, s0, tk, uncoupled ? rows : all_rows, uncoupled ? nr : n_all,
+                                 uncoupled ? NULL : rest, uncoupled ? 0 : nrest, cur) != 0)
+                    return -1;
+            } else {
+                memcpy(cur, s1, bytes);
+            }
+            nc = lc_find_crossings(w, prev, cur, a, b, &w->b_cross, nc);
+            if (nc < 0) return -1;
+            if (nc > before) {
+                for (i = before; i < nc; ++i) ((lc_crossing *)w->b_cross.p)[i].t_hi = tk;
+                break;
+            }
+            swap = prev; prev = cur; cur = swap;
+        }
+    }
+    return nc;
+}
+
 static lc_status step_failed(lc_world *w, const double *backup, double time0, lc_status s, const char *what)
 {
     memcpy(w->state, backup, (size_t)w->count * 6 * sizeof(double));
@@ -276,7 +344,7 @@ lc_status lc_world_step(lc_world *w, double dt)
 {
     size_t bytes;
     double *backup, *s0, *s1, *scratch, remaining, time0;
-    int *rows, nrows = 0, i, events = 0, stalls = 0, nrest = 0;
+    int *rows, nrows = 0, i, events = 0, stalls = 0, nrest = 0, passes = 0;
     if (w == NULL) return LC_ERR_NULL;
     if (!isfinite(dt)) return lc_fail(w, LC_ERR_NOT_FINITE, "dt is not finite (%g)", dt);
     if (!(dt > 0.0) || dt > 1.0) return lc_fail(w, LC_ERR_OUT_OF_RANGE, "dt = %g is outside (0, 1] s", dt);
@@ -292,6 +360,13 @@ lc_status lc_world_step(lc_world *w, double dt)
     scratch = lc_buf_get(&w->b_step_scratch, bytes);
     rows = lc_buf_get(&w->b_rows, (size_t)(w->count > 0 ? w->count : 1) * sizeof(int));
     if (!backup || !s0 || !s1 || !scratch || !rows) return lc_fail(w, LC_ERR_NO_MEMORY, "out of memory in step");
+    if (w->count == 0) {
+        /* nothing to move: time still passes */
+        w->time += dt;
+        add_counters(&w->total, &w->last);
+        w->error[0] = '\0';
+        return LC_OK;
+    }
     memcpy(backup, w->state, (size_t)w->count * 6 * sizeof(double));
     for (i = 0; i < w->count; ++i)
         if (!w->is_static[i]) rows[nrows++] = i;
@@ -313,7 +388,20 @@ lc_status lc_world_step(lc_world *w, double dt)
          * turn little, so a fast spinner is checked over shorter trial intervals. */
         for (i = 0; i < nrows; ++i) wmax = fmax(wmax, fabs(s0[rows[i] * 6 + SW]));
         if (wmax * trial > LC_MAX_TRIAL_ROTATION) trial = LC_MAX_TRIAL_ROTATION / wmax;
+        /* an absurd spin must not split the step without end: at most LC_MAX_TRIALS rotation-limited
+         * intervals (the check is then coarser for that body) */
+        if (trial < dt / LC_MAX_TRIALS) trial = fmin(remaining, dt / LC_MAX_TRIALS);
+        if (++passes > w->def.max_events_per_step + 2 * LC_MAX_TRIALS)
+            return step_failed(w, backup, time0, LC_ERR_NUMERIC,
+                               "the step needed more than max_events_per_step impacts and intervals (stiff forces or extreme speeds?)");
         if (lc_integrate(w, s0, trial, rows, nrows, rest, nrest, s1) != 0) goto oom;
+        for (i = 0; i < nrows; ++i) {
+            int k;
+            for (k = 0; k < 6; ++k)
+                if (!isfinite(s1[rows[i] * 6 + k]))
+                    return step_failed(w, backup, time0, LC_ERR_NUMERIC,
+                                       "integration produced a non-finite state (forces too stiff for dt?)");
+        }
         if (keep_for_warm_start(w, rest, nrest) != 0) goto oom;
         tmin = trial;
 
@@ -325,10 +413,9 @@ lc_status lc_world_step(lc_world *w, double dt)
             nc = lc_find_crossings(w, s0, s1, pairs[2 * i], pairs[2 * i + 1], &w->b_cross, nc);
             if (nc < 0) goto oom;
         }
-        cross = (lc_crossing *)w->b_cross.p;
-        if (nc > 0) {
+        {
             /* a body touching nothing and tied by no spring to another body moves on its own: its
-             * time-of-impact evaluations need only the two bodies, not the whole world */
+             * time-of-impact evaluations (and swept samples) need only the two bodies */
             coupled = lc_buf_get(&w->b_coupled, (size_t)w->count * sizeof(int));
             if (coupled == NULL) goto oom;
             memset(coupled, 0, (size_t)w->count * sizeof(int));
@@ -339,7 +426,10 @@ lc_status lc_world_step(lc_world *w, double dt)
                     coupled[lc_world_body_index(w, w->springs[i].def.body_b)] = 1;
                 }
         }
-
+        for (i = 0; i < nc; ++i) ((lc_crossing *)w->b_cross.p)[i].t_hi = trial;
+        nc = swept_check(w, s0, s1, trial, pairs, np, nc, coupled, rows, nrows, rest, nrest);
+        if (nc < 0) goto oom;
+        cross = (lc_crossing *)w->b_cross.p;
         /* earliest time of impact; a crossing whose gap is still open at the best time so far is later */
         for (i = 0; i < nc; ++i) {
             double tau;
@@ -358,7 +448,7 @@ lc_status lc_world_step(lc_world *w, double dt)
                 g = lc_vertex_edge_gap(w, scratch, cross[i].a, cross[i].vertex, cross[i].b, cross[i].edge);
                 if (g > w->def.contact_gap) continue;
             }
-            tau = lc_time_of_impact(w, s0, tmin, &cross[i], erows, nerows, rest, nrest, scratch);
+            tau = lc_time_of_impact(w, s0, fmin(tmin, cross[i].t_hi), &cross[i], erows, nerows, rest, nrest, scratch);
             if (tau < 0.0) continue;
             if (best < 0 || tau < tmin) { tmin = tau; best = i; }
         }

@@ -212,7 +212,7 @@ void lc_world_destroy(lc_world *w)
     lc_buf_free(&w->b_tmp); lc_buf_free(&w->b_acc); lc_buf_free(&w->b_touch); lc_buf_free(&w->b_rest);
     lc_buf_free(&w->b_pairs); lc_buf_free(&w->b_aabb); lc_buf_free(&w->b_rows); lc_buf_free(&w->b_island);
     lc_buf_free(&w->b_flags); lc_buf_free(&w->b_mat); lc_buf_free(&w->b_vec); lc_buf_free(&w->b_vec2);
-    lc_buf_free(&w->b_step_scratch); lc_buf_free(&w->b_fric); lc_buf_free(&w->b_cfric); lc_buf_free(&w->b_order); lc_buf_free(&w->b_cross);
+    lc_buf_free(&w->b_step_scratch); lc_buf_free(&w->b_sample0); lc_buf_free(&w->b_sample1); lc_buf_free(&w->b_fric); lc_buf_free(&w->b_cfric); lc_buf_free(&w->b_order); lc_buf_free(&w->b_cross);
     lc_buf_free(&w->b_impact); lc_buf_free(&w->b_irows); lc_buf_free(&w->b_coupled); lc_buf_free(&w->b_dacc); lc_buf_free(&w->b_diag); lc_buf_free(&w->b_warm); lc_buf_free(&w->b_hash);
     free(w);
 }
@@ -467,7 +467,8 @@ lc_status lc_world_remove_body(lc_world *w, lc_body_id id)
 
 lc_status lc_world_get_state(const lc_world *w, lc_state_view *out)
 {
-    if (w == NULL || out == NULL) return LC_ERR_NULL;
+    if (w == NULL) return LC_ERR_NULL;
+    if (out == NULL) return lc_fail((lc_world *)w, LC_ERR_NULL, "out is NULL");
     out->count = w->count;
     out->ids = w->ids;
     out->state = w->state;
@@ -781,8 +782,9 @@ lc_status lc_spring_set_params(lc_world *w, lc_spring_id id, double k, double d,
 lc_status lc_spring_get_def(const lc_world *w, lc_spring_id id, lc_spring_def *out)
 {
     int i = spring_index(w, id);
-    if (w == NULL || out == NULL) return LC_ERR_NULL;
-    if (i < 0) return LC_ERR_UNKNOWN_SPRING;
+    if (w == NULL) return LC_ERR_NULL;
+    if (out == NULL) return lc_fail((lc_world *)w, LC_ERR_NULL, "out is NULL");
+    if (i < 0) return lc_fail((lc_world *)w, LC_ERR_UNKNOWN_SPRING, "no spring with id %u", (unsigned)id);
     *out = w->springs[i].def;
     return LC_OK;
 }
@@ -799,8 +801,9 @@ lc_status lc_spring_get_endpoints(const lc_world *w, lc_spring_id id, lc_vec2 *a
 {
     int i = spring_index(w, id);
     const lc_spring_def *d;
-    if (w == NULL || a == NULL || b == NULL) return LC_ERR_NULL;
-    if (i < 0) return LC_ERR_UNKNOWN_SPRING;
+    if (w == NULL) return LC_ERR_NULL;
+    if (a == NULL || b == NULL) return lc_fail((lc_world *)w, LC_ERR_NULL, "endpoint output is NULL");
+    if (i < 0) return lc_fail((lc_world *)w, LC_ERR_UNKNOWN_SPRING, "no spring with id %u", (unsigned)id);
     d = &w->springs[i].def;
     *a = body_point(w, w->state, row_of(w, d->body_a), d->point_a);
     *b = d->body_b == LC_WORLD_ANCHOR ? d->point_b : body_point(w, w->state, row_of(w, d->body_b), d->point_b);
@@ -813,7 +816,8 @@ int lc_world_spring_count(const lc_world *w) { return w ? w->spring_count : 0; }
 
 lc_status lc_world_get_contacts(const lc_world *w, const lc_contact **out, int *out_count)
 {
-    if (w == NULL || out == NULL || out_count == NULL) return LC_ERR_NULL;
+    if (w == NULL) return LC_ERR_NULL;
+    if (out == NULL || out_count == NULL) return lc_fail((lc_world *)w, LC_ERR_NULL, "out or out_count is NULL");
     *out = w->contacts;
     *out_count = w->contact_count;
     return LC_OK;
@@ -821,7 +825,8 @@ lc_status lc_world_get_contacts(const lc_world *w, const lc_contact **out, int *
 
 lc_status lc_world_get_energy(const lc_world *w, lc_energy *out)
 {
-    if (w == NULL || out == NULL) return LC_ERR_NULL;
+    if (w == NULL) return LC_ERR_NULL;
+    if (out == NULL) return lc_fail((lc_world *)w, LC_ERR_NULL, "out is NULL");
     lc_compute_energy(w, w->state, out);
     return LC_OK;
 }

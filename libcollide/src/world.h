@@ -85,6 +85,7 @@ struct lc_world {
     lc_buf b_state0, b_state1, b_backup, b_k[4], b_tmp, b_acc;
     lc_buf b_touch, b_rest, b_pairs, b_aabb, b_rows, b_island, b_flags, b_mat, b_vec, b_vec2, b_order;
     lc_buf b_step_scratch;   /* step.c only: held across the whole step, so no other file may use it */
+    lc_buf b_sample0, b_sample1; /* step.c only: sub-interval states of the swept check */
     lc_buf b_fric;           /* impulse.c: friction rows of an impact */
     lc_buf b_cfric;          /* contact_forces.c: normal and tangent blocks of a friction group */
     lc_buf b_cross, b_impact, b_irows, b_coupled, b_dacc, b_diag, b_warm, b_hash;
@@ -128,10 +129,13 @@ void lc_touch_update(const lc_world *w, const double *state, lc_touch *t);
 int lc_collect_touches(const lc_world *w, const double *state, int a, int b, double max_gap,
                        lc_buf *buf, int count);
 /* Crossing found between two states: vertex of row a entered edge of row b. */
-typedef struct lc_crossing { int a, b, vertex, edge; double toi; } lc_crossing;
+/* t_hi: a time (from the interval's start) by which the vertex is known to be inside. */
+typedef struct lc_crossing { int a, b, vertex, edge; double toi, t_hi; } lc_crossing;
 /* Appends crossings of the pair (a, b) between state0 and state1. Returns new count or -1. */
 int lc_find_crossings(const lc_world *w, const double *s0, const double *s1, int a, int b,
                       lc_buf *buf, int count);
+/* Largest separation of two bodies over the faces of both (< 0: overlapping), the separating axis test. */
+double lc_pair_separation(const lc_world *w, const double *state, int a, int b);
 /* Signed distance of vertex of a from the line of edge of b at state. */
 double lc_vertex_edge_gap(const lc_world *w, const double *state, int a, int vertex, int b, int edge);
 
