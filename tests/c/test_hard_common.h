@@ -61,14 +61,13 @@ typedef struct hc_mon {
 static inline double hc_energy(const lc_world *w, double gx, double gy)
 {
     lc_state_view v;
-    double e = 0.0;
+    double e = sc_kinetic(w);
     int i;
     if (lc_world_get_state(w, &v) != LC_OK) return NAN;
     for (i = 0; i < v.count; i++) {
         const double *s = v.state + 6 * i;
         if (v.is_static[i]) continue;
-        e += 0.5 * v.mass[i] * (s[3] * s[3] + s[4] * s[4]) + 0.5 * v.inertia[i] * s[5] * s[5]
-             - v.mass[i] * (gx * s[0] + gy * s[1]);
+        e -= v.mass[i] * (gx * s[0] + gy * s[1]);
     }
     return e;
 }
