@@ -927,6 +927,11 @@ class SimNode(Node):
                         continue
                     self.step_once()
                 ref_steps += 1
+                if rtf <= 0:
+                    # Flat out, this loop would take the lock back at once: Python's lock is not fair,
+                    # so the executor thread could starve long enough for the command queues to
+                    # overflow. Yielding the GIL hands the lock over when the executor is waiting.
+                    time.sleep(0)
         except KeyboardInterrupt:
             pass
         finally:
