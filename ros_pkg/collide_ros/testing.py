@@ -12,7 +12,8 @@ import sys
 import tempfile
 import time
 from collections import deque
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
@@ -233,3 +234,22 @@ class SimClient:
     def close(self) -> None:
         self.ex.remove_node(self.node)
         self.node.destroy_node()
+
+
+@contextmanager
+def running_sim(*node_args: str) -> Iterator[tuple[SimClient, NodeProcess]]:
+    """A node process with `node_args` and a client in its own rclpy context, once the node publishes
+    bodies/states; on exit both are stopped and the node must have exited cleanly (code 0)."""
+    ctx = rclpy.Context()
+    rclpy.init(context=ctx)
+    proc = NodeProcess(*node_args)
+    client = SimClient(context=ctx)
+    try:
+        ok = client.wait_for(lambda: client.count["bodies/states"] > 0, timeout=60.0)
+        assert ok, f"node published no bodies/states; log:\n{proc.output()}"
+        yield client, proc
+    finally:
+        client.close()
+        code = proc.stop()
+        rclpy.shutdown(context=ctx)
+    assert code == 0, f"node exited with {code}; log:\n{proc.output()}"

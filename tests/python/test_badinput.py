@@ -16,7 +16,6 @@ from typing import Any, Callable, Iterator
 
 import numpy as np
 import pytest
-import rclpy
 from geometry_msgs.msg import Point, Twist, TwistStamped, Vector3, WrenchStamped
 from libcollide_msgs.msg import SpringCommand, ThrusterCommand
 from libcollide_msgs.srv import Kill, Spawn, Step
@@ -26,7 +25,7 @@ from std_srvs.srv import Empty, SetBool
 import collide
 from collide import CollideError, World
 from collide_ros import params as node_params
-from collide_ros.testing import NodeProcess, SimClient
+from collide_ros.testing import SimClient, running_sim
 
 ROOT = Path(__file__).resolve().parents[2]
 NAN, INF = float("nan"), float("inf")
@@ -155,18 +154,8 @@ START = {"block1": (-2.5, 0.0), "block2": (2.5, 0.0)}
 
 @pytest.fixture(scope="module")
 def sim() -> Iterator[SimClient]:
-    ctx = rclpy.Context()
-    rclpy.init(context=ctx)
-    proc = NodeProcess("-p", "blocks:=2", "-p", "state_rate:=100.0")
-    client = SimClient(context=ctx)
-    try:
-        assert client.wait_for(lambda: client.count["bodies/states"] > 0, 60.0), proc.output()
+    with running_sim("-p", "blocks:=2", "-p", "state_rate:=100.0") as (client, _):
         yield client
-    finally:
-        client.close()
-        code = proc.stop()
-        rclpy.shutdown(context=ctx)
-    assert code == 0, f"node exited with {code}; log:\n{proc.output()}"
 
 
 def at_rest(sim: SimClient, names: tuple[str, ...] = ("block1", "block2")) -> bool:

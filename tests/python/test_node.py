@@ -12,13 +12,12 @@ import math
 from typing import Iterator
 
 import pytest
-import rclpy
 from geometry_msgs.msg import Point, Twist, TwistStamped, Vector3, WrenchStamped
 from libcollide_msgs.msg import SpringCommand, ThrusterCommand
 from libcollide_msgs.srv import Kill, Spawn, Step
 from std_srvs.srv import Empty, SetBool
 
-from collide_ros.testing import NodeProcess, SimClient
+from collide_ros.testing import SimClient, running_sim
 
 DT = 0.001
 TIMEOUT = 0.5  # command_timeout used by this module (s, sim time)
@@ -28,19 +27,8 @@ DV_REL_TOL = 0.01
 
 @pytest.fixture(scope="module")
 def sim() -> Iterator[SimClient]:
-    ctx = rclpy.Context()
-    rclpy.init(context=ctx)
-    proc = NodeProcess("-p", "blocks:=2", "-p", f"command_timeout:={TIMEOUT}", "-p", "state_rate:=100.0")
-    client = SimClient(context=ctx)
-    try:
-        ok = client.wait_for(lambda: client.count["bodies/states"] > 0, timeout=60.0)
-        assert ok, f"node published no bodies/states; log:\n{proc.output()}"
+    with running_sim("-p", "blocks:=2", "-p", f"command_timeout:={TIMEOUT}", "-p", "state_rate:=100.0") as (client, _):
         yield client
-    finally:
-        client.close()
-        code = proc.stop()
-        rclpy.shutdown(context=ctx)
-    assert code == 0, f"node exited with {code}; log:\n{proc.output()}"
 
 
 def at_start(sim: SimClient, names: tuple[str, ...] = ("block1", "block2")) -> bool:

@@ -10,7 +10,7 @@ import rclpy
 from geometry_msgs.msg import WrenchStamped
 from std_srvs.srv import Empty
 
-from collide_ros.testing import NodeProcess, SimClient
+from collide_ros.testing import NodeProcess, SimClient, running_sim
 
 SCENE = """\
 version: 1
@@ -26,18 +26,8 @@ bodies:
 def scene_sim(tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[SimClient, NodeProcess]]:
     path = tmp_path_factory.mktemp("scene") / "two.yaml"
     path.write_text(SCENE)
-    ctx = rclpy.Context()
-    rclpy.init(context=ctx)
-    proc = NodeProcess("-p", f"scene_file:={path}", "-p", "cmd_vel_body:=crate")
-    client = SimClient(context=ctx)
-    try:
-        assert client.wait_for(lambda: client.count["bodies/states"] > 0, 60.0), proc.output()
+    with running_sim("-p", f"scene_file:={path}", "-p", "cmd_vel_body:=crate") as (client, proc):
         yield client, proc
-    finally:
-        client.close()
-        code = proc.stop()
-        rclpy.shutdown(context=ctx)
-    assert code == 0, proc.output()
 
 
 def test_scene_file_bodies_and_settings(scene_sim: tuple[SimClient, NodeProcess]) -> None:
