@@ -1,6 +1,13 @@
-/* Collision impulses: eq. 11 of the seed generalised to several points as a complementarity problem
- * (a = A j + b >= 0, j >= 0, j.a = 0 with b = (1 + e) v_n), resolved either serially, one touching
- * body pair at a time, or simultaneously. The wall limit is A's zero inverse mass for static bodies. */
+/* Collision impulses: eq. 11 of the seed generalised to several points as a complementarity problem,
+ * resolved either serially, one touching body pair at a time, or simultaneously. The wall limit is
+ * A's zero inverse mass for static bodies.
+ *
+ * Restitution follows Poisson's hypothesis: first the compression impulse j_c that just stops every
+ * approach (a = A j_c + v_n >= 0, j_c >= 0, j_c.a = 0), then (1 + e) j_c is applied. With one e per
+ * problem the kinetic energy changes by -(1 - e^2)/2 j_c.A j_c <= 0, so e = 1 keeps it exactly and
+ * no e can gain energy. Newton's rule on several points (a = A j + (1 + e) v_n) can: two corners of
+ * a face arriving at different speeds gain up to a few percent per hit. For one point both are
+ * eq. 11: j = -(1 + e) v_n / (n.A n). */
 #include <math.h>
 #include <string.h>
 #include "world.h"
@@ -13,10 +20,12 @@ static double normal_velocity(const double *state, const lc_touch *t)
     return lc_dot(t->n, lc_sub(va, vb));
 }
 
-/* Impacts with Coulomb friction: normal rows a = A j + b >= 0 as without friction, tangent rows aim
- * to stop the sliding, bounded by |j_t| <= mu j_n (boxed complementarity, projected Gauss-Seidel). */
+/* Impacts with Coulomb friction: the compression problem's normal rows as without friction, tangent
+ * rows aim to stop the sliding, bounded by |j_t| <= mu j_n (boxed complementarity, projected
+ * Gauss-Seidel). Restitution scales the normal impulse only: the tangent impulse that stopped the
+ * sliding stays inside the cone (1 + e) mu j_n and is not reversed into a tangential bounce. */
 static int solve_block_friction(lc_world *w, double *state, lc_touch *t, int n, const double *bn,
-                                const lc_lcp_options *opt)
+                                int restitute, const lc_lcp_options *opt)
 {
     int n2 = 2 * n, i, k, hits = 0;
     double *A = lc_buf_get(&w->b_mat, (size_t)n2 * (size_t)n2 * sizeof(double));
@@ -56,6 +65,7 @@ static int solve_block_friction(lc_world *w, double *state, lc_touch *t, int n, 
         double jn = j[i] > 0.0 && isfinite(j[i]) ? j[i] : 0.0;
         double jt = isfinite(j[n + i]) ? j[n + i] : 0.0;
         if (jn <= 0.0) continue;
+        jn *= 1.0 + (restitute ? t[i].elasticity : 0.0);
         lc_touch_apply(w, &t[i], lc_add(lc_scale(t[i].n, jn), lc_scale(lc_tangent_of(t[i].n), jt)), state + 3, 6);
         t[i].value += jn;
         t[i].tangent += jt;
@@ -64,8 +74,10 @@ static int solve_block_friction(lc_world *w, double *state, lc_touch *t, int n, 
     return hits;
 }
 
-/* Solves the impulse problem for touches t[0..n) with per-point restitution (use_e) and applies it.
- * Returns the number of points that received a positive impulse, or -1. */
+/* Solves the impulse problem for touches t[0..n) and applies it: restitution (use_e) by Poisson's
+ * rule, e = 0 when no point approaches faster than resting_speed (so settling ends instead of
+ * bouncing ever smaller: the seed's Zeno "stuck" case). Returns the number of points that received
+ * a positive impulse, or -1. */
 static int solve_block(lc_world *w, double *state, lc_touch *t, int n, int use_e)
 {
     double *A = lc_buf_get(&w->b_mat, (size_t)n * (size_t)n * sizeof(double));
@@ -73,7 +85,7 @@ static int solve_block(lc_world *w, double *state, lc_touch *t, int n, int use_e
     double *j = lc_buf_get(&w->b_vec2, (size_t)n * sizeof(double));
     lc_lcp_options opt;
     lc_lcp_result res;
-    int i, hits = 0;
+    int i, hits = 0, with_friction = 0, restitute = 0;
     if (!A || !b || !j) return -1;
     opt = lc_lcp_default_options();
     opt.exact_max = w->def.lcp_exact_max;
@@ -82,20 +94,13 @@ static int solve_block(lc_world *w, double *state, lc_touch *t, int n, int use_e
     opt.regularization = 1e-12;
     lc_response_matrix(w, t, n, A);
     for (i = 0; i < n; ++i) {
-        double vn = normal_velocity(state, &t[i]);
-        /* restitution only for real approach; slow touches are made to stop (e = 0) so that
-         * settling ends instead of bouncing ever smaller (the seed's Zeno "stuck" case) */
-        double e = use_e && vn < -w->def.resting_speed ? t[i].elasticity : 0.0;
-        b[i] = vn + e * (vn < 0.0 ? vn : 0.0);
+        b[i] = normal_velocity(state, &t[i]);
+        if (use_e && b[i] < -w->def.resting_speed) restitute = 1;
+        if (t[i].friction > 0.0) with_friction = 1;
         j[i] = 0.0;
     }
-    {
-        int with_friction = 0;
-        for (i = 0; i < n; ++i) if (t[i].friction > 0.0) with_friction = 1;
-        if (with_friction) return solve_block_friction(w, state, t, n, b, &opt);
-    }
+    if (with_friction) return solve_block_friction(w, state, t, n, b, restitute, &opt);
     if (n == 1) {
-        /* eq. 11 directly: j = -(1 + e) v_n / (1/m_a + 1/m_b + (r_a x n)^2/I_a + (r_b x n)^2/I_b) */
         j[0] = b[0] < 0.0 && A[0] > 0.0 ? -b[0] / A[0] : 0.0;
         res.iterations = 1;
     } else {
@@ -105,6 +110,7 @@ static int solve_block(lc_world *w, double *state, lc_touch *t, int n, int use_e
     for (i = 0; i < n; ++i) {
         double ji = j[i] > 0.0 && isfinite(j[i]) ? j[i] : 0.0;
         if (ji <= 0.0) continue;
+        ji *= 1.0 + (restitute ? t[i].elasticity : 0.0);
         lc_touch_apply(w, &t[i], lc_scale(t[i].n, ji), state + 3, 6);
         t[i].value += ji;
         hits++;
@@ -117,7 +123,7 @@ static int same_pair(const lc_touch *x, const lc_touch *y)
     return (x->a == y->a && x->b == y->b) || (x->a == y->b && x->b == y->a);
 }
 
-int lc_resolve_impacts(lc_world *w, double *state, lc_touch *t, int n)
+int lc_resolve_impacts(lc_world *w, double *state, lc_touch *t, int n, int elastic)
 {
     int i, hits = 0, iter;
     /* a tiny fraction of the approach speed counts as "still approaching": round-off, not physics */
@@ -132,7 +138,7 @@ int lc_resolve_impacts(lc_world *w, double *state, lc_touch *t, int n)
     }
     eps = 1e-12 * (1.0 + vmax);
     if (w->def.impact_mode == LC_IMPACT_SIMULTANEOUS) {
-        int k = solve_block(w, state, t, n, 1);
+        int k = solve_block(w, state, t, n, elastic);
         if (k < 0) return -1;
         hits += k;
     } else {
@@ -156,7 +162,7 @@ int lc_resolve_impacts(lc_world *w, double *state, lc_touch *t, int n)
             while (start > 0 && same_pair(&t[start - 1], &t[worst])) --start;
             while (end + 1 < n && same_pair(&t[end + 1], &t[worst])) ++end;
             w->last.serial_iterations++;
-            k = solve_block(w, state, t + start, end - start + 1, 1);
+            k = solve_block(w, state, t + start, end - start + 1, elastic);
             if (k < 0) return -1;
             hits += k;
             if (k == 0) break;   /* the solver found nothing to do: avoid spinning */

@@ -86,7 +86,7 @@ static int gather_resting(lc_world *w, double *state, int *impacts)
         lc_touch *x = lc_buf_get(&w->b_impact, (size_t)n * sizeof(lc_touch));
         if (x == NULL) return -1;
         memcpy(x, t, (size_t)n * sizeof(lc_touch));
-        if (lc_resolve_impacts(w, state, x, n) < 0) return -1;
+        if (lc_resolve_impacts(w, state, x, n, *impacts < w->def.max_events_per_step) < 0) return -1;
         for (i = 0; i < n; ++i) {
             if (x[i].value > 0.0) {
                 w->last.impulses++;
@@ -125,8 +125,10 @@ static int find_root(int *parent, int x)
 }
 
 /* Impact set at the time of impact: every touch in the group of bodies connected by touches to the
- * bodies of the impacting crossing (so an impact travels through a row of touching blocks). */
-static int gather_impact(lc_world *w, const double *state, const lc_crossing *c)
+ * bodies of the impacting crossing (so an impact travels through a row of touching blocks). When the
+ * time came from the pair's separation (by_pair), the crossing's vertex need not be the one touching:
+ * the pair's touches are its separating-axis manifold alone. */
+static int gather_impact(lc_world *w, const double *state, const lc_crossing *c, int by_pair)
 {
     int n = gather_touches(w, state, &w->b_impact), i, k = 0, have = 0;
     int *parent;
@@ -141,7 +143,7 @@ static int gather_impact(lc_world *w, const double *state, const lc_crossing *c)
             int ra = find_root(parent, t[i].a), rb = find_root(parent, t[i].b);
             if (ra != rb) parent[ra < rb ? rb : ra] = ra < rb ? ra : rb;
         }
-        if (t[i].a == c->a && t[i].vertex == c->vertex && t[i].b == c->b) {
+        if (!by_pair && t[i].a == c->a && t[i].vertex == c->vertex && t[i].b == c->b) {
             /* at a corner two edges are equally near; the vertex came in through the crossing's edge */
             if (t[i].edge != c->edge) {
                 t[i].edge = c->edge;
@@ -155,7 +157,7 @@ static int gather_impact(lc_world *w, const double *state, const lc_crossing *c)
         int body = w->is_static[t[i].a] ? t[i].b : t[i].a;
         if (find_root(parent, body) == seed) t[k++] = t[i];
     }
-    if (!have) {
+    if (!have && !by_pair) {
         /* the crossing vertex was not found as a touch (e.g. it meets the other body's corner):
          * use the crossing itself so the impact is never lost */
         lc_touch *x = lc_buf_get(&w->b_impact, (size_t)(k + 1) * sizeof(lc_touch));
@@ -294,7 +296,9 @@ static int swept_check(lc_world *w, const double *s0, const double *s1, double h
             const lc_crossing *c = &((const lc_crossing *)w->b_cross.p)[i];
             if ((c->a == a && c->b == b) || (c->a == b && c->b == a)) have = 1;
         }
-        if (have) continue;   /* the end-point test already bracketed this pair */
+        /* the end-point test already bracketed this pair; if another vertex (a corner meeting a
+         * corner) dipped in before that crossing's time, the pair's time of impact finds it */
+        if (have) continue;
         dev = chord_deviation(w, s0, s1, h, a, b);
         sep0 = lc_pair_separation(w, s0, a, b);
         /* touching at the start: resting contacts or impacts already guard the pair */
@@ -332,6 +336,26 @@ static int swept_check(lc_world *w, const double *s0, const double *s1, double h
     return nc;
 }
 
+/* Most crossings one step may set aside as stalled before it stops looking for crossings at all. */
+#define LC_MAX_STALLED 64
+
+/* A crossing whose impact at time 0 had nothing to do (no point approaching: typically a resting point
+ * that the contact forces did not hold exactly across the trial interval, crossing its own gap) would
+ * stop time at that instant forever. Such a vertex is set aside for the rest of the step (the contact
+ * forces and the end-of-step projection hold it), while every other vertex is still checked. */
+static int drop_stalled(lc_world *w, const lc_crossing *stalled, int nstalled, int nc)
+{
+    lc_crossing *c = (lc_crossing *)w->b_cross.p;
+    int i, k, kept = 0;
+    for (i = 0; i < nc; ++i) {
+        int skip = 0;
+        for (k = 0; k < nstalled && !skip; ++k)
+            skip = stalled[k].a == c[i].a && stalled[k].b == c[i].b && stalled[k].vertex == c[i].vertex;
+        if (!skip) c[kept++] = c[i];
+    }
+    return kept;
+}
+
 static lc_status step_failed(lc_world *w, const double *backup, double time0, lc_status s, const char *what)
 {
     memcpy(w->state, backup, (size_t)w->count * 6 * sizeof(double));
@@ -344,7 +368,8 @@ lc_status lc_world_step(lc_world *w, double dt)
 {
     size_t bytes;
     double *backup, *s0, *s1, *scratch, remaining, time0;
-    int *rows, nrows = 0, i, events = 0, stalls = 0, nrest = 0, passes = 0;
+    int *rows, nrows = 0, i, events = 0, nstalled = 0, nrest = 0, passes = 0;
+    lc_crossing stalled[LC_MAX_STALLED];
     if (w == NULL) return LC_ERR_NULL;
     if (!isfinite(dt)) return lc_fail(w, LC_ERR_NOT_FINITE, "dt is not finite (%g)", dt);
     if (!(dt > 0.0) || dt > 1.0) return lc_fail(w, LC_ERR_OUT_OF_RANGE, "dt = %g is outside (0, 1] s", dt);
@@ -373,7 +398,7 @@ lc_status lc_world_step(lc_world *w, double dt)
 
     remaining = dt;
     while (remaining > 0.0) {
-        int np, nc = 0, best = -1, nimp, hits, *coupled = NULL;
+        int np, nc = 0, best = -1, nimp, hits, *coupled = NULL, by_pair = 0;
         double tmin = remaining;
         const int *pairs;
         lc_crossing *cross;
@@ -409,10 +434,11 @@ lc_status lc_world_step(lc_world *w, double dt)
         np = lc_broad_phase(w, s0, s1, w->def.contact_distance, &w->b_pairs);
         if (np < 0) goto oom;
         pairs = (const int *)w->b_pairs.p;
-        for (i = 0; i < np && stalls < 2; ++i) {
+        for (i = 0; i < np && nstalled <= LC_MAX_STALLED; ++i) {
             nc = lc_find_crossings(w, s0, s1, pairs[2 * i], pairs[2 * i + 1], &w->b_cross, nc);
             if (nc < 0) goto oom;
         }
+        nc = drop_stalled(w, stalled, nstalled, nc);
         {
             /* a body touching nothing and tied by no spring to another body moves on its own: its
              * time-of-impact evaluations (and swept samples) need only the two bodies */
@@ -461,7 +487,18 @@ lc_status lc_world_step(lc_world *w, double dt)
         }
 
         if (tmin > 0.0) {
+            int ba = cross[best].a, bb = cross[best].b;
             if (lc_integrate(w, s0, tmin, rows, nrows, rest, nrest, w->state) != 0) goto oom;
+            /* another vertex of the pair (corner against corner) already inside, deeper than any
+             * crossing test can see from here on: the pair met earlier, find when */
+            if (lc_pair_separation(w, w->state, ba, bb) < -0.5 * w->def.contact_gap &&
+                lc_pair_separation(w, s0, ba, bb) > w->def.contact_gap) {
+                double t2 = lc_pair_time_of_impact(w, s0, tmin, ba, bb, rows, nrows, rest, nrest, scratch);
+                if (t2 < 0.0) goto oom;
+                tmin = t2;
+                by_pair = 1;
+                if (lc_integrate(w, s0, tmin, rows, nrows, rest, nrest, w->state) != 0) goto oom;
+            }
         } else {
             memcpy(w->state, s0, (size_t)w->count * 6 * sizeof(double));
         }
@@ -469,9 +506,11 @@ lc_status lc_world_step(lc_world *w, double dt)
         w->time = time0 + (dt - remaining);
         if (remaining < 1e-14 * dt) remaining = 0.0;
 
-        nimp = gather_impact(w, w->state, &cross[best]);
+        nimp = gather_impact(w, w->state, &cross[best], by_pair);
         if (nimp < 0) goto oom;
-        hits = lc_resolve_impacts(w, w->state, (lc_touch *)w->b_impact.p, nimp);
+        /* past max_events_per_step (an impact storm: extreme speeds in a small box, a jam at e > 0)
+         * every further impact is inelastic, which ends the storm; the pass cap above still bounds it */
+        hits = lc_resolve_impacts(w, w->state, (lc_touch *)w->b_impact.p, nimp, events < w->def.max_events_per_step);
         if (hits < 0) goto oom;
         {
             lc_touch *t = (lc_touch *)w->b_impact.p;
@@ -483,9 +522,10 @@ lc_status lc_world_step(lc_world *w, double dt)
         }
         w->last.collisions++;
         events++;
-        /* no progress in time and nothing to push apart: let the contact solver take over next pass */
-        stalls = (hits == 0 && tmin == 0.0) ? stalls + 1 : 0;
-        if (events >= w->def.max_events_per_step) stalls = 2;
+        if (hits == 0 && tmin == 0.0) {
+            if (nstalled < LC_MAX_STALLED) stalled[nstalled] = cross[best];
+            nstalled++;
+        }
     }
     if (remaining == 0.0) w->time = time0 + dt;
     if (project_positions(w) < 0) goto oom;

@@ -108,3 +108,27 @@ double lc_time_of_impact(lc_world *w, const double *s0, double h, const lc_cross
     /* the early end keeps the gap on the positive side of contact_gap: never a penetrating state */
     return a;
 }
+
+/* A vertex-against-edge root is the first contact of that vertex only. Where two corners meet, the
+ * other body's corner can dip in first, entering near the end of an edge and so along a path none of
+ * the crossing tests sees, and be inside at that root. The separating-axis distance of the pair is
+ * continuous in time and negative exactly when the two overlap, so bisecting on it from a separated
+ * start finds a time at which the pair touches at the contact gap and nothing overlaps. */
+double lc_pair_time_of_impact(lc_world *w, const double *s0, double h, int a, int b,
+                              const int *rows, int nrows, lc_touch *touches, int ntouches, double *scratch)
+{
+    const lc_world_def *d = &w->def;
+    double lo = 0.0, hi = h;
+    int it;
+    w->last.toi_searches++;
+    for (it = 0; it < 200 && hi - lo > d->toi_time_tolerance; ++it) {
+        double m = 0.5 * (lo + hi), g;
+        if (lc_integrate(w, s0, m, rows, nrows, touches, ntouches, scratch) != 0) return -1.0;
+        w->last.toi_iterations++;
+        g = lc_pair_separation(w, scratch, a, b) - d->contact_gap;
+        if (!isfinite(g)) return -1.0;
+        if (g > 0.0) lo = m; else hi = m;
+        if (g > 0.0 && g <= d->toi_distance_tolerance) break;
+    }
+    return lo;
+}

@@ -170,14 +170,19 @@ int lc_integrate(lc_world *w, const double *s0, double h, const int *rows, int n
                  lc_touch *touches, int ntouches, double *s1);
 
 /* ---- impulse.c ---- */
-/* Resolves the impact among touches[0..n) at the current state (velocities changed in place).
- * Returns number of points that received an impulse, or -1 on allocation failure. */
-int lc_resolve_impacts(lc_world *w, double *state, lc_touch *t, int n);
+/* Resolves the impact among touches[0..n) at the current state (velocities changed in place), with
+ * restitution when `elastic`, else perfectly inelastic. Returns the number of points that received an
+ * impulse, or -1 on allocation failure. */
+int lc_resolve_impacts(lc_world *w, double *state, lc_touch *t, int n, int elastic);
 
 /* ---- time_of_impact.c ---- */
 /* Time in [0, h] at which the crossing's gap reaches the contact gap; integrates the listed rows. */
 double lc_time_of_impact(lc_world *w, const double *s0, double h, const lc_crossing *c,
                          const int *rows, int nrows, lc_touch *touches, int ntouches, double *scratch);
+/* Time in [0, h] at which bodies a and b, separated by more than the contact gap at s0 and overlapping
+ * at s0 + h, are separated by the contact gap again (bisection on their separating-axis distance). */
+double lc_pair_time_of_impact(lc_world *w, const double *s0, double h, int a, int b,
+                              const int *rows, int nrows, lc_touch *touches, int ntouches, double *scratch);
 
 /* ---- energy.c ---- */
 void lc_compute_energy(const lc_world *w, const double *state, lc_energy *out);
