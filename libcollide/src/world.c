@@ -87,7 +87,7 @@ lc_world_def lc_default_world_def(void)
     d.contact_gap = 1e-7;
     d.contact_distance = 1e-5;
     d.resting_speed = 1e-4;
-    d.stabilization = LC_STABILIZE_VELOCITY_AND_DISTANCE;
+    d.stabilization = LC_STABILIZE_VELOCITY;
     d.elasticity_rule = LC_MIX_MIN;
     d.friction_rule = LC_MIX_GEOMETRIC;
     d.max_events_per_step = 10000;

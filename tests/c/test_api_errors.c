@@ -516,7 +516,7 @@ static void defaults(void)
           "default TOI tolerances 1e-10 s, 1e-10 m, 100 iterations");
     CHECK(d.contact_gap == 1e-7 && d.contact_distance == 1e-5 && d.resting_speed == 1e-4, "%s",
           "default contact_gap 1e-7, contact_distance 1e-5, resting_speed 1e-4");
-    CHECK(d.stabilization == LC_STABILIZE_VELOCITY_AND_DISTANCE && d.elasticity_rule == LC_MIX_MIN &&
+    CHECK(d.stabilization == LC_STABILIZE_VELOCITY && d.elasticity_rule == LC_MIX_MIN &&
               d.friction_rule == LC_MIX_GEOMETRIC, "%s", "default stabilisation and mix rules");
     CHECK(d.max_events_per_step == 10000 && d.max_serial_iterations == 1000 && d.lcp_exact_max == 128 &&
               d.lcp_max_iterations == 200 && d.lcp_tolerance == 1e-10, "%s", "default event and LCP limits");

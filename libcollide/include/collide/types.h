@@ -74,8 +74,8 @@ typedef enum lc_mix_rule {
 /* Drift correction added to resting contacts. */
 typedef enum lc_stabilization {
     LC_STABILIZE_NONE = 0,
-    LC_STABILIZE_VELOCITY = 1,               /* drive residual normal velocity to zero */
-    LC_STABILIZE_VELOCITY_AND_DISTANCE = 2   /* ... and the gap to contact_gap (default) */
+    LC_STABILIZE_VELOCITY = 1,               /* drive residual normal velocity to zero (default; drift is projected out) */
+    LC_STABILIZE_VELOCITY_AND_DISTANCE = 2   /* ... and the gap to contact_gap by force (leaves ~contact_gap/h of speed) */
 } lc_stabilization;
 
 typedef enum lc_body_type {
@@ -98,7 +98,7 @@ typedef struct lc_world_def {
     double contact_gap;            /* m, gap at which impacts are handled and resting contacts are held, [1e-12, 1e-2], default 1e-7 */
     double contact_distance;       /* m, gap below which bodies touch, > contact_gap, <= 1, default 1e-5 */
     double resting_speed;          /* m/s, approach speed below which a touch is resting, not an impact, [0, 10], default 1e-4 */
-    lc_stabilization stabilization;/* default LC_STABILIZE_VELOCITY_AND_DISTANCE */
+    lc_stabilization stabilization;/* default LC_STABILIZE_VELOCITY */
     lc_mix_rule elasticity_rule;   /* default LC_MIX_MIN */
     lc_mix_rule friction_rule;     /* default LC_MIX_GEOMETRIC */
     int max_events_per_step;       /* impacts handled in one step before the rest are resolved inelastically, [1, 1e6], default 10000 */
