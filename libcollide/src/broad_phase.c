@@ -10,8 +10,9 @@ static void body_box(const lc_world *w, const double *s, int row, box *b)
 {
     const lc_shape *sh = &w->shape[row];
     const double *st = &s[row * 6];
-    double c = cos(st[SA]), sn = sin(st[SA]);
+    double c, sn;
     int i;
+    lc_body_trig(w, row, st[SA], &c, &sn);
     b->x0 = b->y0 = INFINITY;
     b->x1 = b->y1 = -INFINITY;
     for (i = 0; i < sh->count; ++i) {

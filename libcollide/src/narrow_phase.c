@@ -5,14 +5,13 @@
 
 typedef struct frame { double x, y, c, s; } frame;
 
-static frame frame_of(const double *state, int row)
+static frame frame_of(const lc_world *w, const double *state, int row)
 {
     frame f;
     const double *s = &state[row * 6];
     f.x = s[SX];
     f.y = s[SY];
-    f.c = cos(s[SA]);
-    f.s = sin(s[SA]);
+    lc_body_trig(w, row, s[SA], &f.c, &f.s);
     return f;
 }
 
@@ -38,14 +37,14 @@ static double edge_param(const lc_shape *sh, int k, lc_vec2 local, double *len_o
 
 double lc_vertex_edge_gap(const lc_world *w, const double *state, int a, int vertex, int b, int edge)
 {
-    frame fa = frame_of(state, a), fb = frame_of(state, b);
+    frame fa = frame_of(w, state, a), fb = frame_of(w, state, b);
     lc_vec2 p = to_world(fa, w->shape[a].v[vertex]);
     return edge_distance(&w->shape[b], edge, to_local(fb, p));
 }
 
 void lc_touch_update(const lc_world *w, const double *state, lc_touch *t)
 {
-    frame fa = frame_of(state, t->a), fb = frame_of(state, t->b);
+    frame fa = frame_of(w, state, t->a), fb = frame_of(w, state, t->b);
     const double *sa = &state[t->a * 6], *sb = &state[t->b * 6];
     lc_vec2 va, vb;
     t->ra = lc_rot(fa.c, fa.s, w->shape[t->a].v[t->vertex]);
@@ -73,7 +72,7 @@ static int push_touch(const lc_world *w, const double *state, lc_buf *buf, int c
                       int a, int vertex, int b, int edge, double max_gap)
 {
     lc_touch *t = (lc_touch *)buf->p;
-    lc_vec2 p = to_world(frame_of(state, a), w->shape[a].v[vertex]);
+    lc_vec2 p = to_world(frame_of(w, state, a), w->shape[a].v[vertex]);
     int j;
     /* a point already recorded for this pair at (nearly) the same place is the same contact */
     for (j = first_of_pair; j < count; ++j) {
@@ -102,7 +101,7 @@ static int push_touch(const lc_world *w, const double *state, lc_buf *buf, int c
 static double max_separation(const lc_world *w, const double *state, int a, int b, int *edge)
 {
     const lc_shape *sa = &w->shape[a], *sb = &w->shape[b];
-    frame fa = frame_of(state, a), fb = frame_of(state, b);
+    frame fa = frame_of(w, state, a), fb = frame_of(w, state, b);
     lc_vec2 local[LC_MAX_POLYGON_VERTICES];
     double best = -INFINITY;
     int i, k;
@@ -124,7 +123,7 @@ static int face_touches(const lc_world *w, const double *state, int inc, int ref
                         lc_buf *buf, int count, int first_of_pair)
 {
     const lc_shape *si = &w->shape[inc], *sr = &w->shape[ref];
-    frame fi = frame_of(state, inc), fr = frame_of(state, ref);
+    frame fi = frame_of(w, state, inc), fr = frame_of(w, state, ref);
     int i;
     for (i = 0; i < si->count && count >= 0; ++i) {
         lc_vec2 local = to_local(fr, to_world(fi, si->v[i]));
@@ -165,10 +164,15 @@ int lc_collect_touches(const lc_world *w, const double *state, int a, int b, dou
         if ((ref == a ? sep_a : sep_b) >= max_gap) return count;
     }
     /* incident face: the face of the other body most opposed to the reference normal */
-    n = lc_rot(cos(state[ref * 6 + SA]), sin(state[ref * 6 + SA]), w->shape[ref].n[kref]);
+    {
+        double c, sn;
+        lc_body_trig(w, ref, state[ref * 6 + SA], &c, &sn);
+        n = lc_rot(c, sn, w->shape[ref].n[kref]);
+    }
     kinc = 0;
     {
-        double c = cos(state[inc * 6 + SA]), sn = sin(state[inc * 6 + SA]);
+        double c, sn;
+        lc_body_trig(w, inc, state[inc * 6 + SA], &c, &sn);
         for (k = 0; k < w->shape[inc].count; ++k) {
             double d = lc_dot(n, lc_rot(c, sn, w->shape[inc].n[k]));
             if (d < best) { best = d; kinc = k; }
@@ -252,10 +256,10 @@ int lc_find_crossings(const lc_world *w, const double *s0, const double *s1, int
 {
     frame fa0, fb0, fa1, fb1;
     if (w->is_static[a] && w->is_static[b]) return count;
-    fa0 = frame_of(s0, a);
-    fb0 = frame_of(s0, b);
-    fa1 = frame_of(s1, a);
-    fb1 = frame_of(s1, b);
+    fa0 = frame_of(w, s0, a);
+    fb0 = frame_of(w, s0, b);
+    fa1 = frame_of(w, s1, a);
+    fb1 = frame_of(w, s1, b);
     count = crossings_one_way(w, a, b, fa0, fb0, fa1, fb1, buf, count);
     if (count < 0) return count;
     return crossings_one_way(w, b, a, fb0, fa0, fb1, fa1, buf, count);

@@ -204,7 +204,7 @@ void lc_world_destroy(lc_world *w)
     if (w == NULL) return;
     free(w->ids); free(w->state); free(w->mass); free(w->inertia); free(w->inv_mass); free(w->inv_inertia);
     free(w->is_static); free(w->elasticity); free(w->friction); free(w->ext_force); free(w->ext_torque);
-    free(w->shape); free(w->thrusters); free(w->thruster_count); free(w->id_to_row);
+    free(w->shape); free(w->trig); free(w->thrusters); free(w->thruster_count); free(w->id_to_row);
     free(w->springs); free(w->contacts);
     lc_lcp_workspace_destroy(w->lcp);
     lc_buf_free(&w->b_state0); lc_buf_free(&w->b_state1); lc_buf_free(&w->b_backup);
@@ -287,7 +287,7 @@ static int reserve_bodies(lc_world *w, int need)
     while (cap < need) cap *= 2;
     GROW(w->ids, cap); GROW(w->mass, cap); GROW(w->inertia, cap); GROW(w->inv_mass, cap);
     GROW(w->inv_inertia, cap); GROW(w->is_static, cap); GROW(w->elasticity, cap); GROW(w->friction, cap);
-    GROW(w->ext_force, cap); GROW(w->ext_torque, cap); GROW(w->shape, cap); GROW(w->thrusters, cap);
+    GROW(w->ext_force, cap); GROW(w->ext_torque, cap); GROW(w->shape, cap); GROW(w->trig, cap); GROW(w->thrusters, cap);
     GROW(w->thruster_count, cap);
     GROW(w->state, (size_t)cap * LC_STATE_SIZE);
     w->capacity = cap;
@@ -357,6 +357,8 @@ lc_status lc_world_add_body(lc_world *w, const lc_body_def *d, lc_body_id *out_i
     if (out_id) *out_id = w->next_body_id;
     w->next_body_id++;
     w->shape[row] = shape;
+    w->trig[row].angle[0] = w->trig[row].angle[1] = NAN;   /* NaN matches no angle: empty */
+    w->trig[row].next = 0;
     c = cos(d->angle);
     sn = sin(d->angle);
     cm = lc_add(d->position, lc_rot(c, sn, shape.center_offset));
@@ -423,8 +425,11 @@ lc_status lc_world_add_walls(lc_world *w, double xmin, double ymin, double xmax,
                 s = lc_fail(w, s, "wall %d has an invalid size", i);
             }
             if (s != LC_OK) {
+                /* the rollback's successful removals clear the message: keep the failure's */
+                char why[sizeof w->error];
+                memcpy(why, w->error, sizeof why);
                 while (w->count > before) lc_world_remove_body(w, w->ids[w->count - 1]);
-                return s;
+                return lc_fail(w, s, "%s", why);
             }
         }
     }
@@ -453,7 +458,7 @@ lc_status lc_world_remove_body(lc_world *w, lc_body_id id)
 #define SHIFT(arr, k) memmove(&(arr)[(size_t)row * (k)], &(arr)[(size_t)(row + 1) * (k)], (size_t)n * (k) * sizeof *(arr))
     SHIFT(w->ids, 1); SHIFT(w->mass, 1); SHIFT(w->inertia, 1); SHIFT(w->inv_mass, 1); SHIFT(w->inv_inertia, 1);
     SHIFT(w->is_static, 1); SHIFT(w->elasticity, 1); SHIFT(w->friction, 1); SHIFT(w->ext_force, 1);
-    SHIFT(w->ext_torque, 1); SHIFT(w->shape, 1); SHIFT(w->thrusters, 1); SHIFT(w->thruster_count, 1);
+    SHIFT(w->ext_torque, 1); SHIFT(w->shape, 1); SHIFT(w->trig, 1); SHIFT(w->thrusters, 1); SHIFT(w->thruster_count, 1);
     SHIFT(w->state, LC_STATE_SIZE);
 #undef SHIFT
     w->count--;
