@@ -2,6 +2,7 @@
  * sort-and-sweep along x above broadphase_threshold (AUTO). */
 #include <math.h>
 #include <stdlib.h>
+#include <string.h>
 #include "world.h"
 
 typedef struct box { double x0, y0, x1, y1; int row; } box;
@@ -10,8 +11,17 @@ static void body_box(const lc_world *w, const double *s, int row, box *b)
 {
     const lc_shape *sh = &w->shape[row];
     const double *st = &s[row * 6];
-    double c, sn;
-    int i;
+    lc_trig *cache = &w->trig[row];
+    double c, sn, *out;
+    int i, k;
+    /* each pass asks for the boxes at its start state twice (resting set, then the trial) */
+    for (k = 0; k < 2; ++k)
+        if (memcmp(cache->pose[k], st, 3 * sizeof(double)) == 0) {
+            b->x0 = cache->box[k][0]; b->y0 = cache->box[k][1];
+            b->x1 = cache->box[k][2]; b->y1 = cache->box[k][3];
+            b->row = row;
+            return;
+        }
     lc_body_trig(w, row, st[SA], &c, &sn);
     b->x0 = b->y0 = INFINITY;
     b->x1 = b->y1 = -INFINITY;
@@ -24,6 +34,11 @@ static void body_box(const lc_world *w, const double *s, int row, box *b)
         if (y > b->y1) b->y1 = y;
     }
     b->row = row;
+    k = cache->box_next;
+    cache->box_next = 1 - k;
+    memcpy(cache->pose[k], st, 3 * sizeof(double));
+    out = cache->box[k];
+    out[0] = b->x0; out[1] = b->y0; out[2] = b->x1; out[3] = b->y1;
 }
 
 static int overlap(const box *a, const box *b)

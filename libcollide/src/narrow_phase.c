@@ -150,6 +150,12 @@ int lc_collect_touches(const lc_world *w, const double *state, int a, int b, dou
     double sep_a, sep_b, best = INFINITY;
     lc_vec2 n;
     if (w->is_static[a] && w->is_static[b]) return count;
+    {
+        /* bounding circles farther apart than max_gap: no touch, without the separating-axis test */
+        double dx = state[a * 6 + SX] - state[b * 6 + SX], dy = state[a * 6 + SY] - state[b * 6 + SY];
+        double r = w->shape[a].radius + w->shape[b].radius + max_gap;
+        if (dx * dx + dy * dy > r * r) return count;
+    }
     /* The contact normal of a pair comes from its separating axis: the face of either body along
      * which they are farthest apart (least overlap). At coincident corners of side-by-side boxes this
      * picks the shared vertical faces, never the collinear top or bottom faces. */

@@ -295,6 +295,12 @@ static double chord_deviation(const lc_world *w, const double *s0, const double 
     return turn * turn * (w->shape[a].radius + w->shape[b].radius) / 8.0 + (dva + dvb) * h / 8.0;
 }
 
+/* Distance between the bodies' bounding circles (negative when they overlap). */
+static double circle_gap(const lc_world *w, const double *s, int a, int b)
+{
+    return hypot(s[a * 6 + SX] - s[b * 6 + SX], s[a * 6 + SY] - s[b * 6 + SY]) - w->shape[a].radius - w->shape[b].radius;
+}
+
 /* Vertices that dip into another body and come back out within the interval are invisible to the
  * end-point test. For pairs that end up closer than their chords can stray, the two bodies' motion is
  * sampled at LC_SWEEP_SAMPLES sub-times and every sub-interval is tested; a crossing found there
@@ -316,6 +322,11 @@ static int swept_check(lc_world *w, const double *s0, const double *s1, double h
          * corner) dipped in before that crossing's time, the pair's time of impact finds it */
         if (have) continue;
         dev = chord_deviation(w, s0, s1, h, a, b);
+        /* bounding circles apart by more than the paths can stray, at both ends: nothing can dip in
+         * (the circles' distance is a lower bound of the bodies' distance, as the separation is) */
+        if (circle_gap(w, s0, a, b) > dev + w->def.contact_distance &&
+            circle_gap(w, s1, a, b) > dev + w->def.contact_distance)
+            continue;
         sep0 = lc_pair_separation(w, s0, a, b);
         /* touching at the start: resting contacts or impacts already guard the pair */
         if (sep0 < w->def.contact_distance) continue;

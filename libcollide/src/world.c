@@ -359,6 +359,8 @@ lc_status lc_world_add_body(lc_world *w, const lc_body_def *d, lc_body_id *out_i
     w->shape[row] = shape;
     w->trig[row].angle[0] = w->trig[row].angle[1] = NAN;   /* NaN matches no angle: empty */
     w->trig[row].next = 0;
+    w->trig[row].pose[0][2] = w->trig[row].pose[1][2] = NAN;
+    w->trig[row].box_next = 0;
     c = cos(d->angle);
     sn = sin(d->angle);
     cm = lc_add(d->position, lc_rot(c, sn, shape.center_offset));

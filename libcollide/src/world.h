@@ -51,10 +51,13 @@ typedef struct lc_buf {  /* growable scratch array */
     size_t cap;          /* bytes */
 } lc_buf;
 
-/* The last two angles a body was seen at and their cosine and sine (see lc_body_trig). */
+/* The last two angles a body was seen at and their cosine and sine (see lc_body_trig), and the last
+ * two poses (x, y, angle) and their bounding boxes (broad_phase.c). */
 typedef struct lc_trig {
     double angle[2], c[2], s[2];
     int next;
+    double pose[2][3], box[2][4];
+    int box_next;
 } lc_trig;
 
 struct lc_world {
