@@ -71,12 +71,12 @@ static int cmp_pair(const void *x, const void *y)
     return a[1] - b[1];
 }
 
-int lc_broad_phase(lc_world *w, const double *s0, const double *s1, double margin, lc_buf *buf)
+/* Every body's box over the interval (both end poses), grown by margin, indexed by row. */
+static box *swept_boxes(lc_world *w, const double *s0, const double *s1, double margin)
 {
-    int n = w->count, i, j, count = 0;
+    int n = w->count, i;
     box *boxes = lc_buf_get(&w->b_aabb, (size_t)(n > 0 ? n : 1) * sizeof(box));
-    int use_sweep;
-    if (boxes == NULL) return -1;
+    if (boxes == NULL) return NULL;
     for (i = 0; i < n; ++i) {
         box b0, b1;
         body_box(w, s0, i, &b0);
@@ -90,6 +90,15 @@ int lc_broad_phase(lc_world *w, const double *s0, const double *s1, double margi
         b0.x0 -= margin; b0.y0 -= margin; b0.x1 += margin; b0.y1 += margin;
         boxes[i] = b0;
     }
+    return boxes;
+}
+
+int lc_broad_phase(lc_world *w, const double *s0, const double *s1, double margin, lc_buf *buf)
+{
+    int n = w->count, i, j, count = 0;
+    box *boxes = swept_boxes(w, s0, s1, margin);
+    int use_sweep;
+    if (boxes == NULL) return -1;
     use_sweep = w->def.broadphase == LC_BROADPHASE_SORT_AND_SWEEP ||
                 (w->def.broadphase == LC_BROADPHASE_AUTO && n >= w->def.broadphase_threshold);
     if (!use_sweep) {
@@ -115,6 +124,28 @@ int lc_broad_phase(lc_world *w, const double *s0, const double *s1, double margi
         /* same pair order as brute force, so results do not depend on the broadphase */
         if (count > 1) qsort(buf->p, (size_t)count, 2 * sizeof(int), cmp_pair);
     }
+    w->last.broadphase_pairs += (uint64_t)count;
+    return count;
+}
+
+int lc_broad_phase_of(lc_world *w, const double *s0, const double *s1, double margin, const uint8_t *marked,
+                      const int *list, int nlist, lc_buf *buf)
+{
+    int n = w->count, k, j, count = 0;
+    box *boxes = swept_boxes(w, s0, s1, margin);
+    if (boxes == NULL) return -1;
+    /* neither brute force nor sort-and-sweep over the world: not counted as either */
+    for (k = 0; k < nlist; ++k) {
+        int i = list[k];
+        for (j = 0; j < n; ++j) {
+            if (j == i || (marked[j] && j < i)) continue;   /* a pair of two marked bodies once */
+            if (w->is_static[i] && w->is_static[j]) continue;
+            if (!overlap(&boxes[i], &boxes[j])) continue;
+            count = add_pair(buf, count, i, j);
+            if (count < 0) return -1;
+        }
+    }
+    if (count > 1) qsort(buf->p, (size_t)count, 2 * sizeof(int), cmp_pair);
     w->last.broadphase_pairs += (uint64_t)count;
     return count;
 }

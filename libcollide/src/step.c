@@ -383,6 +383,21 @@ static int drop_stalled(lc_world *w, const lc_crossing *stalled, int nstalled, i
     return kept;
 }
 
+/* Crossings of the previous pass between two bodies the last impact did not touch, with their bracket
+ * moved to the new start (tmin later). One whose bracket ended before the new start is dropped. */
+static int keep_clean_crossings(lc_world *w, const uint8_t *dirty, double tmin)
+{
+    lc_crossing *c = (lc_crossing *)w->b_cross.p;
+    int i, kept = 0, nc = w->cross_count;
+    for (i = 0; i < nc; ++i) {
+        if (dirty[c[i].a] || dirty[c[i].b]) continue;
+        c[i].t_hi -= tmin;
+        if (!(c[i].t_hi > 0.0)) continue;
+        c[kept++] = c[i];
+    }
+    return kept;
+}
+
 static lc_status step_failed(lc_world *w, const double *backup, double time0, lc_status s, const char *what)
 {
     memcpy(w->state, backup, (size_t)w->count * 6 * sizeof(double));
@@ -396,6 +411,9 @@ lc_status lc_world_step(lc_world *w, double dt)
     size_t bytes;
     double *backup, *s0, *s1, *scratch, remaining, time0;
     int *rows, nrows = 0, i, events = 0, nstalled = 0, nrest = 0, passes = 0;
+    int *drows, ndirty = 0, local_next = 0, body_springs = 0;
+    uint8_t *dirty;
+    double last_tmin = 0.0, trial_left = 0.0;
     lc_crossing stalled[LC_MAX_STALLED];
     if (w == NULL) return LC_ERR_NULL;
     if (!isfinite(dt)) return lc_fail(w, LC_ERR_NOT_FINITE, "dt is not finite (%g)", dt);
@@ -422,16 +440,23 @@ lc_status lc_world_step(lc_world *w, double dt)
     memcpy(backup, w->state, (size_t)w->count * 6 * sizeof(double));
     for (i = 0; i < w->count; ++i)
         if (!w->is_static[i]) rows[nrows++] = i;
+    dirty = lc_buf_get(&w->b_dirty, (size_t)w->count);
+    drows = lc_buf_get(&w->b_drows, (size_t)w->count * sizeof(int));
+    if (!dirty || !drows) return lc_fail(w, LC_ERR_NO_MEMORY, "out of memory in step");
+    memset(dirty, 0, (size_t)w->count);
+    for (i = 0; i < w->spring_count; ++i)
+        if (w->springs[i].def.body_b != LC_WORLD_ANCHOR) body_springs = 1;
 
     remaining = dt;
     while (remaining > 0.0) {
-        int np, nc = 0, best = -1, nimp, hits, *coupled = NULL, by_pair = 0;
+        int np, nc = 0, nkept = 0, best = -1, nimp, hits, *coupled = NULL, by_pair = 0;
         double tmin = remaining;
         const int *pairs;
         lc_crossing *cross;
         lc_touch *rest;
 
         double trial = remaining, wmax = 0.0;
+        int events_before = events, local = 0, can_reuse;
         nrest = gather_resting(w, w->state, &events);
         if (nrest < 0) goto oom;
         rest = (lc_touch *)w->b_touch.p;
@@ -443,10 +468,24 @@ lc_status lc_world_step(lc_world *w, double dt)
         /* an absurd spin must not split the step without end: at most LC_MAX_TRIALS rotation-limited
          * intervals (the check is then coarser for that body) */
         if (trial < dt / LC_MAX_TRIALS) trial = fmin(remaining, dt / LC_MAX_TRIALS);
+        /* the rest of the previous trial, if the turning limit allows it: then its end is the same */
+        can_reuse = local_next && trial_left > 0.0 && trial_left <= trial;
+        if (can_reuse) trial = trial_left;
         if (++passes > w->def.max_events_per_step + 2 * LC_MAX_TRIALS)
             return step_failed(w, backup, time0, LC_ERR_NUMERIC,
                                "the step needed more than max_events_per_step impacts and intervals (stiff forces or extreme speeds?)");
-        if (lc_integrate(w, s0, trial, rows, nrows, rest, nrest, s1) != 0) goto oom;
+        /* After an impact in free flight (nothing resting, no spring between bodies, the same trial
+         * end), only the bodies of that impact move differently: every other body keeps its trial
+         * path to the previous trial's end, and the crossings found between two such bodies stay
+         * valid. Then only the impact's bodies are re-advanced, to that same end, and only their pairs
+         * are tested again, instead of the whole world. */
+        local = can_reuse && nrest == 0 && events == events_before && !body_springs;
+        if (local) {
+            if (lc_integrate(w, s0, trial, drows, ndirty, rest, 0, scratch) != 0) goto oom;
+            for (i = 0; i < ndirty; ++i) memcpy(&s1[drows[i] * 6], &scratch[drows[i] * 6], 6 * sizeof(double));
+        } else {
+            if (lc_integrate(w, s0, trial, rows, nrows, rest, nrest, s1) != 0) goto oom;
+        }
         for (i = 0; i < nrows; ++i) {
             int k;
             for (k = 0; k < 6; ++k)
@@ -458,7 +497,12 @@ lc_status lc_world_step(lc_world *w, double dt)
         tmin = trial;
 
         /* vertices that entered another body during the trial step */
-        np = lc_broad_phase(w, s0, s1, w->def.contact_distance, &w->b_pairs);
+        if (local) {
+            nc = nkept = keep_clean_crossings(w, dirty, last_tmin);
+            np = lc_broad_phase_of(w, s0, s1, w->def.contact_distance, dirty, drows, ndirty, &w->b_pairs);
+        } else {
+            np = lc_broad_phase(w, s0, s1, w->def.contact_distance, &w->b_pairs);
+        }
         if (np < 0) goto oom;
         pairs = (const int *)w->b_pairs.p;
         for (i = 0; i < np && nstalled <= LC_MAX_STALLED; ++i) {
@@ -479,10 +523,11 @@ lc_status lc_world_step(lc_world *w, double dt)
                     coupled[lc_world_body_index(w, w->springs[i].def.body_b)] = 1;
                 }
         }
-        for (i = 0; i < nc; ++i) ((lc_crossing *)w->b_cross.p)[i].t_hi = trial;
+        for (i = nkept; i < nc; ++i) ((lc_crossing *)w->b_cross.p)[i].t_hi = trial;
         nc = swept_check(w, s0, s1, trial, pairs, np, nc, coupled, rows, nrows, rest, nrest);
         if (nc < 0) goto oom;
         cross = (lc_crossing *)w->b_cross.p;
+        w->cross_count = nc;
         /* earliest time of impact; a crossing whose gap is still open at the best time so far is later */
         for (i = 0; i < nc; ++i) {
             double tau;
@@ -506,6 +551,7 @@ lc_status lc_world_step(lc_world *w, double dt)
             if (best < 0 || tau < tmin) { tmin = tau; best = i; }
         }
         if (best < 0) {
+            local_next = 0;
             memcpy(w->state, s1, (size_t)w->count * 6 * sizeof(double));
             remaining -= trial;
             if (remaining < 1e-14 * dt) remaining = 0.0;
@@ -549,6 +595,22 @@ lc_status lc_world_step(lc_world *w, double dt)
         }
         w->last.collisions++;
         events++;
+        {
+            /* the impact's bodies are the ones whose paths changed (see `local` above) */
+            lc_touch *t = (lc_touch *)w->b_impact.p;
+            for (i = 0; i < ndirty; ++i) dirty[drows[i]] = 0;
+            ndirty = 0;
+            for (i = 0; i < nimp; ++i) {
+                int ab[2], q;
+                ab[0] = t[i].a;
+                ab[1] = t[i].b;
+                for (q = 0; q < 2; ++q)
+                    if (!w->is_static[ab[q]] && !dirty[ab[q]]) { dirty[ab[q]] = 1; drows[ndirty++] = ab[q]; }
+            }
+            local_next = nrest == 0;
+            trial_left = trial - tmin;
+            last_tmin = tmin;
+        }
         if (hits == 0 && tmin == 0.0) {
             if (nstalled < LC_MAX_STALLED) stalled[nstalled] = cross[best];
             nstalled++;

@@ -98,6 +98,8 @@ struct lc_world {
     lc_buf b_touch, b_rest, b_pairs, b_aabb, b_rows, b_island, b_flags, b_mat, b_vec, b_vec2, b_order;
     lc_buf b_step_scratch;   /* step.c only: held across the whole step, so no other file may use it */
     lc_buf b_sample0, b_sample1; /* step.c only: sub-interval states of the swept check */
+    lc_buf b_dirty, b_drows; /* step.c only: bodies whose motion the last impact changed */
+    int cross_count;         /* step.c only: crossings in b_cross at the end of the last pass */
     lc_buf b_fric;           /* impulse.c: friction rows of an impact */
     lc_buf b_cfric;          /* contact_forces.c: normal and tangent blocks of a friction group */
     lc_buf b_cross, b_impact, b_irows, b_coupled, b_dacc, b_diag, b_warm, b_hash;
@@ -155,6 +157,9 @@ double lc_vertex_edge_gap(const lc_world *w, const double *state, int a, int ver
 /* Candidate pairs (a < b by row, not both static) whose boxes, swept from s0 to s1 (s1 may equal s0) and
  * grown by margin, overlap. Writes pairs as int[2] into buf; returns count or -1. */
 int lc_broad_phase(lc_world *w, const double *s0, const double *s1, double margin, lc_buf *buf);
+/* The same, restricted to pairs with at least one of the nlist bodies in list (marked[row] != 0). */
+int lc_broad_phase_of(lc_world *w, const double *s0, const double *s1, double margin, const uint8_t *marked,
+                      const int *list, int nlist, lc_buf *buf);
 
 /* ---- response.c ---- */
 /* Change of relative velocity along di at touch ti per unit impulse along dj at touch tj (J M^-1 J^T). */
