@@ -10,11 +10,15 @@
 /* Most rotation-limited intervals in one step. */
 #define LC_MAX_TRIALS 1024
 
-/* Touches between all near pairs at `state` with gap < contact_distance, appended to buf from 0. */
-static int gather_touches(lc_world *w, const double *state, lc_buf *buf)
+/* Touches at `state` with gap < contact_distance, appended to buf from 0: between all near pairs, or
+ * (list != NULL) only the pairs with at least one of the listed bodies (marked[row] != 0). */
+static int gather_touches_of(lc_world *w, const double *state, const uint8_t *marked, const int *list, int nlist,
+                             lc_buf *buf)
 {
-    int np = lc_broad_phase(w, state, state, w->def.contact_distance, &w->b_pairs), i, n = 0;
+    int np, i, n = 0;
     const int *pairs;
+    np = list ? lc_broad_phase_of(w, state, state, w->def.contact_distance, marked, list, nlist, &w->b_pairs)
+              : lc_broad_phase(w, state, state, w->def.contact_distance, &w->b_pairs);
     if (np < 0) return -1;
     pairs = (const int *)w->b_pairs.p;
     for (i = 0; i < np; ++i) {
@@ -22,6 +26,12 @@ static int gather_touches(lc_world *w, const double *state, lc_buf *buf)
         if (n < 0) return -1;
     }
     return n;
+}
+
+/* Touches between all near pairs at `state` with gap < contact_distance, appended to buf from 0. */
+static int gather_touches(lc_world *w, const double *state, lc_buf *buf)
+{
+    return gather_touches_of(w, state, NULL, NULL, 0, buf);
 }
 
 static int push_contact(lc_world *w, const lc_touch *t, lc_contact_kind kind);
@@ -73,11 +83,12 @@ static int warm_start(lc_world *w, lc_touch *t, int n)
     return 0;
 }
 
-static int gather_resting(lc_world *w, double *state, int *impacts)
+static int gather_resting(lc_world *w, double *state, int *impacts, const uint8_t *marked, const int *list,
+                          int nlist)
 {
     int n, i, k = 0, urgent = 0;
     lc_touch *t;
-    n = gather_touches(w, state, &w->b_touch);
+    n = gather_touches_of(w, state, marked, list, nlist, &w->b_touch);
     t = (lc_touch *)w->b_touch.p;
     if (n < 0) return -1;
     for (i = 0; i < n; ++i)
@@ -118,32 +129,42 @@ static int keep_for_warm_start(lc_world *w, const lc_touch *t, int n)
     return 0;
 }
 
-static int find_root(int *parent, int x)
-{
-    while (parent[x] != x) { parent[x] = parent[parent[x]]; x = parent[x]; }
-    return x;
-}
-
 /* Impact set at the time of impact: every touch in the group of bodies connected by touches to the
- * bodies of the impacting crossing (so an impact travels through a row of touching blocks). When the
- * time came from the pair's separation (by_pair), the crossing's vertex need not be the one touching:
- * the pair's touches are its separating-axis manifold alone. */
+ * bodies of the impacting crossing (so an impact travels through a row of touching blocks), found by
+ * spreading out from those two bodies, so its cost follows the group's size rather than the world's.
+ * When the time came from the pair's separation (by_pair), the crossing's vertex need not be the one
+ * touching: the pair's touches are its separating-axis manifold alone. */
 static int gather_impact(lc_world *w, const double *state, const lc_crossing *c, int by_pair)
 {
-    int n = gather_touches(w, state, &w->b_impact), i, k = 0, have = 0;
-    int *parent;
-    lc_touch *t = (lc_touch *)w->b_impact.p;
-    int seed;
-    if (n < 0) return -1;
-    parent = lc_buf_get(&w->b_island, (size_t)w->count * sizeof(int));
-    if (parent == NULL) return -1;
-    for (i = 0; i < w->count; ++i) parent[i] = i;
-    for (i = 0; i < n; ++i) {
-        if (!w->is_static[t[i].a] && !w->is_static[t[i].b]) {
-            int ra = find_root(parent, t[i].a), rb = find_root(parent, t[i].b);
-            if (ra != rb) parent[ra < rb ? rb : ra] = ra < rb ? ra : rb;
+    int *queue = lc_buf_get(&w->b_group, (size_t)w->count * (sizeof(int) + 1));
+    uint8_t *seen;   /* 1 queued, 2 done */
+    int n = 0, i, k, q, nq = 0, have = 0;
+    lc_touch *t;
+    if (queue == NULL) return -1;
+    seen = (uint8_t *)(queue + w->count);
+    memset(seen, 0, (size_t)w->count);
+    if (!w->is_static[c->a]) { seen[c->a] = 1; queue[nq++] = c->a; }
+    if (!w->is_static[c->b]) { seen[c->b] = 1; queue[nq++] = c->b; }
+    for (q = 0; q < nq; ++q) {
+        int body = queue[q];
+        for (k = 0; k < w->count; ++k) {
+            double dx, dy, r;
+            int before = n;
+            if (k == body || seen[k] == 2) continue;   /* a pair with a finished body was collected */
+            dx = state[body * 6 + SX] - state[k * 6 + SX];
+            dy = state[body * 6 + SY] - state[k * 6 + SY];
+            r = w->shape[body].radius + w->shape[k].radius + w->def.contact_distance;
+            if (dx * dx + dy * dy > r * r) continue;
+            n = lc_collect_touches(w, state, body < k ? body : k, body < k ? k : body, w->def.contact_distance,
+                                   &w->b_impact, n);
+            if (n < 0) return -1;
+            if (n > before && !w->is_static[k] && !seen[k]) { seen[k] = 1; queue[nq++] = k; }
         }
-        if (!by_pair && t[i].a == c->a && t[i].vertex == c->vertex && t[i].b == c->b) {
+        seen[body] = 2;
+    }
+    t = (lc_touch *)w->b_impact.p;
+    for (i = 0; i < n && !by_pair; ++i)
+        if (t[i].a == c->a && t[i].vertex == c->vertex && t[i].b == c->b) {
             /* at a corner two edges are equally near; the vertex came in through the crossing's edge */
             if (t[i].edge != c->edge) {
                 t[i].edge = c->edge;
@@ -151,28 +172,22 @@ static int gather_impact(lc_world *w, const double *state, const lc_crossing *c,
             }
             have = 1;
         }
-    }
-    seed = find_root(parent, w->is_static[c->a] ? c->b : c->a);
-    for (i = 0; i < n; ++i) {
-        int body = w->is_static[t[i].a] ? t[i].b : t[i].a;
-        if (find_root(parent, body) == seed) t[k++] = t[i];
-    }
     if (!have && !by_pair) {
         /* the crossing vertex was not found as a touch (e.g. it meets the other body's corner):
          * use the crossing itself so the impact is never lost */
-        lc_touch *x = lc_buf_get(&w->b_impact, (size_t)(k + 1) * sizeof(lc_touch));
+        lc_touch *x = lc_buf_get(&w->b_impact, (size_t)(n + 1) * sizeof(lc_touch));
         if (x == NULL) return -1;
-        memset(&x[k], 0, sizeof x[k]);
-        x[k].a = c->a;
-        x[k].b = c->b;
-        x[k].vertex = c->vertex;
-        x[k].edge = c->edge;
-        x[k].elasticity = fmin(w->elasticity[c->a], w->elasticity[c->b]);
-        x[k].friction = sqrt(w->friction[c->a] * w->friction[c->b]);
-        lc_touch_update(w, state, &x[k]);
-        k++;
+        memset(&x[n], 0, sizeof x[n]);
+        x[n].a = c->a;
+        x[n].b = c->b;
+        x[n].vertex = c->vertex;
+        x[n].edge = c->edge;
+        x[n].elasticity = fmin(w->elasticity[c->a], w->elasticity[c->b]);
+        x[n].friction = sqrt(w->friction[c->a] * w->friction[c->b]);
+        lc_touch_update(w, state, &x[n]);
+        n++;
     }
-    return k;
+    return n;
 }
 
 static int push_contact(lc_world *w, const lc_touch *t, lc_contact_kind kind)
@@ -457,7 +472,12 @@ lc_status lc_world_step(lc_world *w, double dt)
 
         double trial = remaining, wmax = 0.0;
         int events_before = events, local = 0, can_reuse;
-        nrest = gather_resting(w, w->state, &events);
+        /* after an impact in free flight only the impact's bodies can have come to touch anything:
+         * every other pair was apart (nothing rested) and moved without an impact */
+        if (local_next && !body_springs)
+            nrest = gather_resting(w, w->state, &events, dirty, drows, ndirty);
+        else
+            nrest = gather_resting(w, w->state, &events, NULL, NULL, 0);
         if (nrest < 0) goto oom;
         rest = (lc_touch *)w->b_touch.p;
         memcpy(s0, w->state, (size_t)w->count * 6 * sizeof(double));

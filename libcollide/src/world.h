@@ -99,6 +99,7 @@ struct lc_world {
     lc_buf b_step_scratch;   /* step.c only: held across the whole step, so no other file may use it */
     lc_buf b_sample0, b_sample1; /* step.c only: sub-interval states of the swept check */
     lc_buf b_dirty, b_drows; /* step.c only: bodies whose motion the last impact changed */
+    lc_buf b_group;          /* step.c only: bodies of an impact group, in the order found */
     int cross_count;         /* step.c only: crossings in b_cross at the end of the last pass */
     lc_buf b_fric;           /* impulse.c: friction rows of an impact */
     lc_buf b_cfric;          /* contact_forces.c: normal and tangent blocks of a friction group */
