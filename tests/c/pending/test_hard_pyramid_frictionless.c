@@ -1,4 +1,9 @@
-/* test_hard_pyramid: issue 4 hard case (4), Box2D's "large pyramid" layout with base 20 (210 unit
+/* test_hard_pyramid_frictionless: PENDING, the frictionless case of tests/c/test_hard_pyramid.c. It
+ * fails: the first step's impacts (the faces start at gap 0; 11 events closed by the inelastic
+ * fallback) leave a box sliding sideways at ~1.8e-3 m/s, 1.4 cm in 10 s (bound 1e-4 m). With friction
+ * the same start passes.
+ *
+ * test_hard_pyramid: issue 4 hard case (4), Box2D's "large pyramid" layout with base 20 (210 unit
  * boxes, 1 m x 1 m, 1 kg; row i at y = 0.5 + i, box j of it at x = (i + 1)/2 + (j - i) - base/2, all
  * faces touching) on a static ground box 60 m x 1 m (top face y = 0), g = 10 m/s^2 (Box2D's), e = 0,
  * friction mu = 0.6 on every body and, second case, frictionless (every contact normal is vertical
@@ -106,7 +111,6 @@ static void pyramid(double mu, const char *label)
 
 int main(void)
 {
-    pyramid(0.6, "pyramid base 20, mu = 0.6");
     pyramid(0.0, "pyramid base 20, frictionless");
-    return CHECK_SUMMARY("test_hard_pyramid");
+    return CHECK_SUMMARY("test_hard_pyramid_frictionless");
 }
