@@ -258,16 +258,19 @@ static void add_counters(lc_counters *total, const lc_counters *last)
  * push faces that start touching apart at ~contact_gap/h, and a push-only force cannot brake that).
  * Crossings must start above half the gap's depth, so this is also the backstop that keeps drift in
  * a jammed pile from becoming an overlap nothing can see: no step ends overlapping. */
-static int project_once(lc_world *w)
+static int project_once(lc_world *w, double *deepest)
 {
     int n = gather_touches(w, w->state, &w->b_impact), i, k = 0;
     lc_touch *t = (lc_touch *)w->b_impact.p;
     double *A, *b, *lam;
     lc_lcp_options opt;
     lc_lcp_result res;
+    *deepest = INFINITY;
     if (n <= 0) return n;
-    for (i = 0; i < n; ++i)
+    for (i = 0; i < n; ++i) {
         if (t[i].gap < 0.5 * w->def.contact_gap) k = 1;
+        if (t[i].gap < *deepest) *deepest = t[i].gap;
+    }
     if (!k) return 0;
     /* every touch takes part, so pushing one pair apart does not push a neighbour in */
     A = lc_buf_get(&w->b_mat, (size_t)n * (size_t)n * sizeof(double));
@@ -294,15 +297,22 @@ static int project_once(lc_world *w)
 
 /* The linearised rotation leaves a second-order remainder after a deep correction (a sliver's corner
  * millimetres in after an impact storm): a few passes take it below round-off. */
-#define LC_PROJECTION_PASSES 4
+#define LC_PROJECTION_PASSES 16
+/* Overlap (m) a step may end with: round-off of the projection. */
+#define LC_OVERLAP_TOLERANCE 1e-9
+/* 0 done, 1 still overlapping after every pass (forces far beyond what dt can resolve), -1 no memory. */
 static int project_positions(lc_world *w)
 {
     int pass, r = 0;
-    for (pass = 0; pass < LC_PROJECTION_PASSES; ++pass) {
-        r = project_once(w);
+    double deepest = INFINITY;
+    for (pass = 0; pass <= LC_PROJECTION_PASSES; ++pass) {
+        r = project_once(w, &deepest);
         if (r <= 0) break;
     }
-    return r < 0 ? -1 : 0;
+    if (r < 0) return -1;
+    /* the last pass projected again: its touches were measured before that pass */
+    if (r > 0 && deepest < -LC_OVERLAP_TOLERANCE) return 1;
+    return 0;
 }
 
 /* How far a vertex of one body can stray, in the other's frame, from the straight chord between its
@@ -648,7 +658,13 @@ lc_status lc_world_step(lc_world *w, double dt)
         }
     }
     if (remaining == 0.0) w->time = time0 + dt;
-    if (project_positions(w) < 0) goto oom;
+    {
+        int pr = project_positions(w);
+        if (pr < 0) goto oom;
+        if (pr > 0)
+            return step_failed(w, backup, time0, LC_ERR_NUMERIC,
+                               "bodies still overlap after the end-of-step projection (forces far too large for dt?)");
+    }
 
     /* resting contacts at the end of the step, with the forces of the last evaluation */
     {
