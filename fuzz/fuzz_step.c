@@ -8,7 +8,9 @@
  * Invariants checked (a violation calls fz_fail(), which aborts the harness, never the library):
  *  - every call either returns LC_OK or returns an error with a non-empty lc_world_last_error(),
  *    and a failed call leaves the state hash unchanged ("the world is unchanged on failure");
- *  - a successful step needs at most FZ_MAX_FORCE_EVALS force evaluations (work, not wall time);
+ *  - a step, successful or failed, needs at most FZ_MAX_FORCE_EVALS force evaluations and
+ *    FZ_MAX_SERIAL_ITERS serial impulse iterations (work, not wall time: the verdict is the same on
+ *    any machine, under any load, with or without sanitizers);
  *  - after every step (successful or not): time and every state number are finite, and no two
  *    bodies (except static-static pairs, which the engine never separates) overlap by more than
  *    FZ_OVERLAP_TOL + round-off, measured here with our own separating-axis test on the world
@@ -43,6 +45,12 @@
  * reported as a finding (counted, so the verdict does not depend on the machine's speed). */
 #ifndef FZ_MAX_FORCE_EVALS
 #define FZ_MAX_FORCE_EVALS 1000000ULL
+#endif
+/* The other unbounded work of a step: serial impulse passes (lc_counters.serial_iterations), each a
+ * small LCP solve. Passing seeds and regressions need at most ~1.2e4 in a step (the 10 000-event
+ * cap, about one pass each); 1e5 is seconds of CPU under ASan. */
+#ifndef FZ_MAX_SERIAL_ITERS
+#define FZ_MAX_SERIAL_ITERS 100000ULL
 #endif
 /* Overlap allowed at the end of a step (m): the engine projects every touch back to contact_gap
  * (>= 1e-12 m), so anything deeper than 1e-9 m is a real overlap, not round-off of the projection. */
@@ -466,9 +474,15 @@ static void fz_step(fz_in *in, fz_ctx *c)
             lc_counters last;
             char msg[160];
             if (lc_world_get_counters(c->w, &last, NULL) != LC_OK) fz_fail("lc_world_get_counters failed", after);
-            if (s == LC_OK && last.force_evaluations > FZ_MAX_FORCE_EVALS) {
+            /* failed steps too: a step that gives up after seconds of work is as slow as one that succeeds */
+            if (last.force_evaluations > FZ_MAX_FORCE_EVALS) {
                 snprintf(msg, sizeof msg, "%llu force evaluations in %s", (unsigned long long)last.force_evaluations, after);
                 fz_fail("one step took more than FZ_MAX_FORCE_EVALS force evaluations", msg);
+            }
+            if (last.serial_iterations > FZ_MAX_SERIAL_ITERS) {
+                snprintf(msg, sizeof msg, "%llu serial impulse iterations in %s", (unsigned long long)last.serial_iterations,
+                         after);
+                fz_fail("one step took more than FZ_MAX_SERIAL_ITERS serial impulse iterations", msg);
             }
         }
         if (s != LC_OK) break;
@@ -713,7 +727,10 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 #include <sys/wait.h>
 #include <unistd.h>
 
-#define FZ_REPLAY_SECONDS 10 /* an input runs in milliseconds; 10 s is a hang (as libFuzzer -timeout=10) */
+/* Slowness is judged by the work counters above (the same verdict on any machine); this alarm only
+ * ends a step that never returns. Inputs within the work bounds take seconds under ASan; those over
+ * them (findings) took up to 41 s under ASan on the 2-core machine at load 6, so 120 s is a hang. */
+#define FZ_REPLAY_SECONDS 120
 
 static int fz_replay_file(const char *path)
 {

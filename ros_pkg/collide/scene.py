@@ -8,6 +8,7 @@ import json
 import math
 import os
 import re
+import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable, Mapping, Union
@@ -53,6 +54,9 @@ class _Parsed:
         self.lines: dict[Path_, int] = {}
         self.errors: list[tuple[int | None, str, str]] = []
         self.nodes = 0
+        # one per parse: a constructor remembers every node it built (constructed_objects), so a
+        # shared one kept every scalar of every scene ever loaded (found by the fuzzer's memory growth)
+        self.constructor = yaml.constructor.SafeConstructor()
 
     def line(self, path: Path_) -> int | None:
         while path not in self.lines and path:
@@ -63,10 +67,55 @@ class _Parsed:
         self.errors.append((self.line(path), _fmt_path(path), msg))
 
 
-_constructor = yaml.constructor.SafeConstructor()
-
-
 _MAX_NODES = 1_000_000  # aliases can expand a small file exponentially ("billion laughs")
+# A valid scene nests 6 levels (bodies[0].thrusters[0].point[0]); PyYAML's composer, json's decoder
+# and _to_python recurse once per level, so a file nested thousands deep would hit RecursionError.
+_MAX_DEPTH = 32
+_TAG_MAP = "tag:yaml.org,2002:map"
+_TAG_SEQ = "tag:yaml.org,2002:seq"
+
+
+def _too_deep(source: str, line: int | None, path: Path_) -> SceneError:
+    shown = _fmt_path(path[:4]) + ("..." if len(path) > 4 else "")
+    return SceneError(source, [(line, shown, f"nested more than {_MAX_DEPTH} levels deep "
+                                             f"(a valid scene nests at most 6)")])
+
+
+class _DepthLimitedLoader(yaml.SafeLoader):
+    """SafeLoader whose (recursive) composer refuses to go deeper than _MAX_DEPTH, before recursing."""
+
+    def __init__(self, stream: str, source: str) -> None:
+        super().__init__(stream)
+        self._lc_source = source
+        self._lc_path: list[Union[str, int]] = []
+
+    def compose_node(self, parent: yaml.Node | None, index: Any) -> yaml.Node:
+        # the composer calls (None, None) for the root, (node, None) for a key, (node, key node)
+        # for a mapping value and (node, i) for a sequence item
+        if parent is None:
+            return super().compose_node(parent, index)
+        if isinstance(index, int):
+            step: Union[str, int] = index
+        else:
+            step = index.value if isinstance(index, yaml.ScalarNode) else "<key>"
+        if len(self._lc_path) >= _MAX_DEPTH:
+            mark = self.peek_event().start_mark
+            raise _too_deep(self._lc_source, mark.line + 1, tuple(self._lc_path) + (step,))
+        self._lc_path.append(step)
+        try:
+            return super().compose_node(parent, index)
+        finally:
+            self._lc_path.pop()
+
+
+def _scalar(node: yaml.ScalarNode, path: Path_, parsed: _Parsed) -> Any:
+    try:
+        return parsed.constructor.construct_object(node, deep=True)
+    except yaml.constructor.ConstructorError:
+        msg = f"unsupported YAML tag {node.tag!r} (scene files use plain values)"
+    except Exception as exc:  # noqa: BLE001 - PyYAML's constructors fail with Value/Key/Attribute errors
+        msg = f"cannot read {node.value[:40]!r} as {node.tag.rsplit(':', 1)[-1]}: {type(exc).__name__}"
+    raise SceneError(parsed.source, [(node.start_mark.line + 1, _fmt_path(path) or "(top level)", msg)])
 
 
 def _to_python(node: yaml.Node, path: Path_, parsed: _Parsed, ancestors: tuple[int, ...] = ()) -> Any:
@@ -77,6 +126,12 @@ def _to_python(node: yaml.Node, path: Path_, parsed: _Parsed, ancestors: tuple[i
                                           f"the scene expands to more than {_MAX_NODES} values (aliases?)")])
     if id(node) in ancestors:
         raise SceneError(parsed.source, [(node.start_mark.line + 1, _fmt_path(path), "recursive alias")])
+    # the composer bounds each tree, but an alias can graft one deep tree onto another
+    if len(path) > _MAX_DEPTH:
+        raise _too_deep(parsed.source, node.start_mark.line + 1, path)
+    if node.tag not in (_TAG_MAP, _TAG_SEQ) and not isinstance(node, yaml.ScalarNode):
+        raise SceneError(parsed.source, [(node.start_mark.line + 1, _fmt_path(path) or "(top level)",
+                                          f"unsupported YAML tag {node.tag!r} (scene files use plain values)")])
     ancestors = ancestors + (id(node),)
     if isinstance(node, yaml.MappingNode):
         out: dict[Any, Any] = {}
@@ -93,22 +148,50 @@ def _to_python(node: yaml.Node, path: Path_, parsed: _Parsed, ancestors: tuple[i
         return out
     if isinstance(node, yaml.SequenceNode):
         return [_to_python(v, path + (i,), parsed, ancestors) for i, v in enumerate(node.value)]
-    value = _constructor.construct_object(node, deep=True)
+    value = _scalar(node, path, parsed)
     if isinstance(value, str) and node.style is None and _NUMBER.fullmatch(value):
         # YAML 1.1 reads 1e-7 (no dot) or NaN as text; a plain scalar that looks like a number is one.
         return float(value.replace(".", "")) if "n" in value.lower() else float(value)
     return value
 
 
+# a string (to its closing quote, or to the end if unterminated: never backtracks) or a bracket
+_JSON_TOKEN = re.compile(r'"(?:[^"\\]|\\.)*"?|[\[\]{}]', re.DOTALL)
+
+
+def _json_nests_too_deep(text: str) -> bool:
+    """Whether brackets outside strings nest deeper than _MAX_DEPTH (json's decoder recurses per level)."""
+    depth = 0
+    for m in _JSON_TOKEN.finditer(text):
+        tok = m.group()
+        if tok in ("[", "{"):
+            depth += 1
+            if depth > _MAX_DEPTH:
+                return True
+        elif tok in ("]", "}"):
+            depth -= 1
+    return False
+
+
+def _compose(text: str, source: str) -> yaml.Node | None:
+    loader = _DepthLimitedLoader(text, source)
+    try:
+        return loader.get_single_node()
+    finally:
+        loader.dispose()
+
+
 def _parse_text(text: str, source: str, is_json: bool) -> tuple[Any, _Parsed]:
     parsed = _Parsed(source)
-    if is_json:
+    # JSON syntax first: clear messages for a truncated or malformed file. Too deep a file skips it:
+    # the composer below reports the depth with the path where it was exceeded.
+    if is_json and not _json_nests_too_deep(text):
         try:
-            json.loads(text)  # JSON syntax first: clear messages for a truncated or malformed file
+            json.loads(text)
         except json.JSONDecodeError as exc:
             raise SceneError(source, [(exc.lineno, "", f"invalid JSON: {exc.msg} (column {exc.colno})")]) from None
     try:
-        node = yaml.compose(text, Loader=yaml.SafeLoader)
+        node = _compose(text, source)
     except yaml.MarkedYAMLError as exc:
         mark = exc.problem_mark or exc.context_mark
         what = " ".join(x for x in (exc.context, exc.problem) if x)
@@ -128,6 +211,9 @@ Check = Callable[[Any, Path_, _Parsed], Any]
 def _number(v: Any, path: Path_, p: _Parsed) -> Any:
     if isinstance(v, bool) or not isinstance(v, (int, float)):
         p.error(path, f"expected a number, got {_show(v)}")
+        return _MISSING
+    if isinstance(v, int) and abs(v) > sys.float_info.max:  # float() of it would raise OverflowError
+        p.error(path, f"must be a finite number, got an integer of {len(str(abs(v)))} digits")
         return _MISSING
     if not math.isfinite(v):
         p.error(path, f"must be a finite number, got {v}")
@@ -262,14 +348,17 @@ _SHAPES = {"box": {"width": (_number, _MISSING), "height": (_number, _MISSING)},
 
 
 def _body(v: Any, path: Path_, p: _Parsed) -> Any:
-    shape = v.get("shape") if isinstance(v, dict) else None
-    if isinstance(v, dict) and shape not in _SHAPES:
+    if not isinstance(v, dict):
+        p.error(path, f"expected a body (a mapping with name, shape, ...), got {_show(v)}")
+        return _MISSING
+    shape = v.get("shape")
+    if not isinstance(shape, str) or shape not in _SHAPES:  # a list or mapping is not even hashable
         if "shape" in v:
             p.error(path + ("shape",), f"expected 'box' or 'polygon', got {_show(shape)}")
         else:
             p.error(path, "missing required key 'shape' (box or polygon)")
         return _MISSING
-    return _mapping(v, path, p, {"name": _BODY_COMMON["name"], "shape": _BODY_COMMON["shape"], **_SHAPES[str(shape)],
+    return _mapping(v, path, p, {"name": _BODY_COMMON["name"], "shape": _BODY_COMMON["shape"], **_SHAPES[shape],
                                  **_BODY_COMMON})
 
 
@@ -284,7 +373,8 @@ def _list_of(check: Check) -> Check:
 
 
 _TOP_SPEC = {"version": (_integer, 1), "description": (_optional(_string), None),
-             "world": (lambda v, path, p: _mapping(v, path, p, _WORLD_SPEC), {}),
+             # absent = every field unset, the same dict a present world gets: to_dict() round-trips
+             "world": (lambda v, path, p: _mapping(v, path, p, _WORLD_SPEC), dict.fromkeys(_WORLD_SPEC)),
              "walls": (_optional(lambda v, path, p: _mapping(v, path, p, _WALLS_SPEC)), None),
              "bodies": (_list_of(_body), _MISSING),
              "springs": (_list_of(lambda v, path, p: _mapping(v, path, p, _SPRING_SPEC)), []),
@@ -407,10 +497,27 @@ def _from_data(data: Any, parsed: _Parsed, validate: bool) -> Scene:
     return scene
 
 
+def _deeper_than_limit(data: Any) -> Path_ | None:
+    """The first path longer than _MAX_DEPTH in plain data (walked without recursion), or None."""
+    stack: list[tuple[Any, Path_]] = [(data, ())]
+    while stack:
+        value, path = stack.pop()
+        items = value.items() if isinstance(value, dict) else enumerate(value) if isinstance(value, list) else ()
+        for key, child in items:
+            sub = path + (key if isinstance(key, (str, int)) else str(key),)
+            if len(sub) > _MAX_DEPTH:
+                return sub
+            stack.append((child, sub))
+    return None
+
+
 def load_scene(source: Union[str, os.PathLike[str], dict[str, Any]], validate: bool = True) -> Scene:
     """Read a scene from a YAML/JSON file path or from a dict; raise SceneError if malformed."""
     if isinstance(source, dict):
         parsed = _Parsed("<dict>")
+        deep = _deeper_than_limit(source)
+        if deep is not None:  # before deepcopy, which recurses per level
+            raise _too_deep(parsed.source, None, deep)
         return _from_data(copy.deepcopy(source), parsed, validate)
     if not isinstance(source, (str, os.PathLike)):
         raise TypeError(f"load_scene takes a path or a dict, got {type(source).__name__}")
