@@ -14,6 +14,9 @@ rejected commands); then:
   node's own WARN threshold) or level WARN with "falling behind" in its message;
 * alive: diagnostics kept coming (>= 1 per 2 s of load: the 1 Hz publisher sits in the stepping
   loop, so a frozen loop shows as a gap) and sim time advanced during the load;
+* counted: in the command flood the node's own counts of block1/thrust (received/ and lost/ in
+  /diagnostics) add up to the messages sent: what DDS dropped from the full command queue is
+  reported, not silently gone;
 * recovered: after the load a diagnostics window with real_time_factor >= 0.95 and level OK,
   a fresh thrusters command is accepted (its echo on applied/thrusters arrives), ~/step answers,
   and the parameters the spam touched hold their last accepted value.
@@ -45,6 +48,8 @@ class Phase:
     name: str
     sent: int = 0
     accepted: int = 0   # command flood: echoes seen on applied/block1/thrust
+    node_counts: dict[str, int] = field(default_factory=dict)  # command flood: the node's received/accepted/
+    # rejected/lost of block1/thrust during the flood, from /diagnostics
     seconds: float = 0.0
     rate_hz: float = 0.0
     answered: int = 0
@@ -125,7 +130,8 @@ class Load:
             ph.rejected_during = int(during[-1]["rejected_commands"]) - int(during[0]["rejected_commands"])
         self._recover(ph)
         self._verdict(ph, len(during))
-        self.log(f"load: {name:<18} sent {ph.sent:7d} (answered/accepted {ph.answered or ph.accepted}) "
+        took = f"; node took {ph.node_counts}" if ph.node_counts else ""
+        self.log(f"load: {name:<18} sent {ph.sent:7d} (answered/accepted {ph.answered or ph.accepted}{took}) "
                  f"in {ph.seconds:5.1f} s ({ph.rate_hz:8.0f}/s)  "
                  f"min RTF {ph.min_rtf:.3f} {'WARN' if ph.warned else 'ok  '}  recovered RTF "
                  f"{ph.recovery_rtf:.3f}  accepted after: {ph.accepted_after}")
@@ -171,8 +177,16 @@ class Load:
         msg = WrenchStamped()
         msg.wrench.force.x = 0.01  # tiny, accepted, echoed: each one costs the node a full callback
         pub = self.c._pubs[("block1/thrust", WrenchStamped)]
+        # One message first, taken by the node before the flood: the node counts gaps in this
+        # publisher's sequence numbers from the first message it took (lost/<topic>).
+        pub.publish(msg)
+        if not self.c.wait_for(lambda: self.thrust_echoes > 0, 15.0):
+            ph.failures.append("flood: the first command was not echoed")
+            return
+        before = self._settled_thrust_counts(lambda d: d.get("received/block1/thrust") == "1")
         e0 = self.thrust_echoes
         t0 = time.monotonic()
+        until = t0 + self._phase_seconds  # the flood itself lasts the phase, after this preparation
         while True:
             now = time.monotonic()
             if now >= until:
@@ -186,6 +200,28 @@ class Load:
         ph.seconds = time.monotonic() - t0
         self.c.spin(1.0)
         ph.accepted = self.thrust_echoes - e0
+        after = self._settled_thrust_counts()
+        if before is None or after is None:
+            ph.failures.append("flood: no settled block1/thrust counts in /diagnostics")
+        else:
+            ph.node_counts = {k: after[k] - before[k] for k in after}
+
+    def _settled_thrust_counts(self, ok: Callable[[dict[str, str]], bool] = lambda d: True,
+                               timeout: float = 15.0) -> dict[str, int] | None:
+        """The node's counts of block1/thrust once two consecutive diagnostics agree (and ``ok``)."""
+        keys = [f"{w}/block1/thrust" for w in ("received", "accepted", "rejected", "lost")]
+        end = time.monotonic() + timeout
+        n = len(self.diags)
+        prev = None
+        while time.monotonic() < end:
+            self.c.spin(0.1)
+            for d in self.diags[n:]:
+                cur = {k.split("/")[0]: int(d.get(k, -1)) for k in keys}
+                if cur == prev and ok(d):
+                    return cur
+                prev = cur
+            n = len(self.diags)
+        return None
 
     def slow_subscriber(self, ph: Phase, until: float) -> None:
         """A child process subscribes (reliable) to everything the node publishes, reads for a

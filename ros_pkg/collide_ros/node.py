@@ -14,7 +14,8 @@ import math
 import sys
 import threading
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import Any
 
@@ -45,8 +46,13 @@ from collide_ros import cdr, markers, params, qos
 WARN_PERIOD = 1.0  # s (wall) between two warnings with the same key
 MAX_STEPS_PER_CALL = 1_000_000  # ~/step upper bound per request
 APPLIED = "applied/"  # prefix of the command echo topics
-APPLIED = "applied/"  # prefix of the command echo topics
-MAX_PENDING_COLLISIONS = 100_000  # impacts kept between two contacts publishes (more are dropped)
+# Contacts per contacts message (impacts since the last one first, then resting contacts); more
+# are dropped and counted (dropped_contacts). A reliable writer's history keeps every slot's
+# largest message (Fast DDS reallocates a slot's buffer upwards, never down), so the node's memory
+# grows towards state_qos_depth x the largest contacts message: 1000 contacts (~74 kB) x 100 =
+# ~7 MB. Uncapped, the soak saw 100 000 impacts (7.4 MB) in one message and the RSS grew by 94 MiB
+# in an hour (docs/hardening.md, "Soak").
+MAX_CONTACTS_PER_MESSAGE = 1000
 MAX_CMD_SPEED = 1000.0  # m/s or rad/s: larger cmd_vel components are rejected
 CATCH_UP_LIMIT = 0.1  # s (wall): a loop further behind than this drops the backlog (counted as late)
 
@@ -73,6 +79,38 @@ class _SpringEntry:
     spring: Any     # collide.Spring
     body: str
     point: tuple[float, float]  # body frame, about the centre of mass
+
+
+class _CountedPublisher:
+    """An rclpy publisher that counts its publish() calls, for the ``published/<topic>`` values of
+    /diagnostics: one int increment per message, whatever the message holds."""
+
+    __slots__ = ("pub", "count")
+
+    def __init__(self, pub: Any) -> None:
+        self.pub = pub
+        self.count = 0
+
+    def publish(self, msg: Any) -> None:
+        self.pub.publish(msg)
+        self.count += 1
+
+
+class _CommandCounts:
+    """Per command topic: messages the node took (received = accepted + rejected) and the ones DDS
+    dropped before the node took them (lost: gaps in the publisher's sequence numbers)."""
+
+    __slots__ = ("received", "accepted", "rejected", "lost", "topic", "writer", "last_seq")
+
+    def __init__(self) -> None:
+        self.received = self.accepted = self.rejected = self.lost = 0
+        self.topic = ""            # resolved topic name (for the graph query on a gap)
+        self.writer: tuple[int, ...] | None = None  # gid of the only publisher when last_seq was seen
+        self.last_seq = -1         # its publication sequence number of the last message taken
+
+    def restart(self, topic: str) -> None:
+        """A new subscription: sequence numbers start over."""
+        self.topic, self.writer, self.last_seq = topic, None, -1
 
 
 def _hex_color(value: Any, fallback: markers.Color) -> markers.Color:
@@ -113,9 +151,13 @@ class SimNode(Node):
     def __init__(self, **kwargs: Any) -> None:
         super().__init__("sim", **kwargs)
         self._lock = threading.RLock()  # world and command state: stepping thread vs executor thread
+        self._lock_waiters = 0  # executor threads waiting for self._lock (see _executor_lock)
+        self._waiters_lock = threading.Lock()
         self._warned: dict[str, float] = {}
         self.rejected = 0
         self.last_rejection = ""
+        self._published: dict[str, _CountedPublisher] = {}  # diagnostics key (topic without '/') -> publisher
+        self._commands: dict[str, _CommandCounts] = {}      # command topic (relative) -> counts
         # ---- parameters ----
         # scene_file first: a scene file supplies the defaults of gravity, damping, elasticity and
         # green_mass (its own settings), which -p on the command line still overrides.
@@ -139,14 +181,15 @@ class SimNode(Node):
         self.world: collide.World
         self._build_world()  # raises on a bad scene file: the node cannot start without a world
         # ---- publishers ----
-        self._pub_poses = self.create_publisher(PoseArray, "bodies/poses", qos.STATE)
-        self._pub_states = self.create_publisher(BodyStates, "bodies/states", qos.STATE)
-        self._pub_contacts = self.create_publisher(Contacts, "contacts", qos.STATE)
-        self._pub_energy = self.create_publisher(Energy, "energy", qos.STATE)
-        self._pub_clock = self.create_publisher(Clock, "/clock", qos.CLOCK)
-        self._pub_tf = self.create_publisher(TFMessage, "/tf", qos.TF)
-        self._pub_markers = self.create_publisher(MarkerArray, "markers", qos.MARKERS)
-        self._pub_diag = self.create_publisher(DiagnosticArray, "/diagnostics", qos.DIAGNOSTICS)
+        state_qos = qos.state(int(self._p["state_qos_depth"]))
+        self._pub_poses = self._publisher(PoseArray, "bodies/poses", state_qos)
+        self._pub_states = self._publisher(BodyStates, "bodies/states", state_qos)
+        self._pub_contacts = self._publisher(Contacts, "contacts", state_qos)
+        self._pub_energy = self._publisher(Energy, "energy", state_qos)
+        self._pub_clock = self._publisher(Clock, "/clock", qos.CLOCK)
+        self._pub_tf = self._publisher(TFMessage, "/tf", qos.TF)
+        self._pub_markers = self._publisher(MarkerArray, "markers", qos.MARKERS)
+        self._pub_diag = self._publisher(DiagnosticArray, "/diagnostics", qos.DIAGNOSTICS)
         # ---- commands ----
         self._thrust: dict[str, _Thrust] = {}
         self._thrusters: dict[str, float] = {}   # body -> sim time of the last non-zero mask
@@ -155,17 +198,17 @@ class SimNode(Node):
         self._ext_bodies: set[str] = set()
         self._pending: list[np.ndarray] = []
         self._pending_count = 0
+        self.dropped_contacts = 0  # beyond MAX_CONTACTS_PER_MESSAGE, since the start
         self._thrust_subs: dict[str, Any] = {}
-        self._echo_pubs: dict[str, Any] = {
-            "thrusters": self.create_publisher(ThrusterCommand, APPLIED + "thrusters", qos.COMMAND),
-            "spring": self.create_publisher(SpringCommand, APPLIED + "spring", qos.COMMAND),
-            "cmd_vel": self.create_publisher(TwistStamped, APPLIED + "cmd_vel", qos.COMMAND),
+        self._echo_pubs: dict[str, _CountedPublisher] = {
+            "thrusters": self._publisher(ThrusterCommand, APPLIED + "thrusters", qos.COMMAND),
+            "spring": self._publisher(SpringCommand, APPLIED + "spring", qos.COMMAND),
+            "cmd_vel": self._publisher(TwistStamped, APPLIED + "cmd_vel", qos.COMMAND),
         }
         self._overrides = QoSOverridingOptions.with_default_policies()
-        self.create_subscription(ThrusterCommand, "thrusters", self._guard("thrusters", self._on_thrusters),
-                                 qos.COMMAND, qos_overriding_options=self._overrides)
-        self.create_subscription(SpringCommand, "spring", self._guard("spring", self._on_spring),
-                                 qos.COMMAND, qos_overriding_options=self._overrides)
+        self._subscribe(ThrusterCommand, "thrusters", "thrusters", self._on_thrusters,
+                        qos_overriding_options=self._overrides)
+        self._subscribe(SpringCommand, "spring", "spring", self._on_spring, qos_overriding_options=self._overrides)
         self._cmd_vel_sub: Any = None
         self._cmd_vel_sub_stamped: bool | None = None
         self._make_cmd_vel_sub()
@@ -198,6 +241,23 @@ class SimNode(Node):
             f"sim ready: {len(self.world.names)} bodies ({', '.join(self._dyn_names[:8])}"
             f"{' ...' if len(self._dyn_names) > 8 else ''}), dt {self._p['time_step']} s, "
             f"RTF {self._p['real_time_factor']}, {'paused' if self._paused else 'running'}")
+
+    def _publisher(self, msg_type: Any, topic: str, profile: Any) -> _CountedPublisher:
+        """A counted publisher; its count is ``published/<topic without a leading '/'>`` in /diagnostics."""
+        pub = _CountedPublisher(self.create_publisher(msg_type, topic, profile))
+        self._published[topic.lstrip("/")] = pub
+        return pub
+
+    def _unpublish(self, topic: str, pub: _CountedPublisher) -> None:
+        self._published.pop(topic.lstrip("/"), None)
+        self.destroy_publisher(pub.pub)
+
+    def _subscribe(self, msg_type: Any, topic: str, kind: str, fn: Callable[[Any], None], **kwargs: Any) -> Any:
+        """A command subscription whose messages are counted (``received/<topic>`` ...) and guarded."""
+        counts = self._commands.setdefault(topic, _CommandCounts())
+        sub = self.create_subscription(msg_type, topic, self._guard(kind, counts, fn), qos.COMMAND, **kwargs)
+        counts.restart(sub.topic_name)
+        return sub
 
     def _declare(self, spec: params.Spec, default: Any) -> None:
         """Declare one parameter; an integer given on the command line for a double (-p gravity:=5)
@@ -289,15 +349,16 @@ class SimNode(Node):
         want = set(self._dyn_names[: int(self._p["max_body_topics"])])
         for name in list(self._thrust_subs):
             if name not in want:
+                # the counts go with the topic: a later body of the same name starts from zero
                 self.destroy_subscription(self._thrust_subs.pop(name))
-                self.destroy_publisher(self._echo_pubs.pop(f"{name}/thrust"))
+                self._commands.pop(f"{name}/thrust", None)
+                self._unpublish(f"{APPLIED}{name}/thrust", self._echo_pubs.pop(f"{name}/thrust"))
         for name in self._dyn_names:
             if name in want and name not in self._thrust_subs and params.valid_body_name(name) is None:
-                self._echo_pubs[f"{name}/thrust"] = self.create_publisher(
+                self._echo_pubs[f"{name}/thrust"] = self._publisher(
                     WrenchStamped, f"{APPLIED}{name}/thrust", qos.COMMAND)
-                self._thrust_subs[name] = self.create_subscription(
-                    WrenchStamped, f"{name}/thrust", self._guard("thrust", self._thrust_callback(name)),
-                    qos.COMMAND)
+                self._thrust_subs[name] = self._subscribe(WrenchStamped, f"{name}/thrust", "thrust",
+                                                          self._thrust_callback(name))
         # forget commands and springs of bodies that are gone
         for name in [n for n in self._thrust if n not in self._row_of]:
             del self._thrust[name]
@@ -334,19 +395,65 @@ class SimNode(Node):
         self.last_rejection = msg
         self._warn(key, f"rejected: {msg}")
 
-    def _guard(self, kind: str, fn: Callable[[Any], None]) -> Callable[[Any], None]:
-        def wrapped(msg: Any) -> None:
+    @contextmanager
+    def _executor_lock(self) -> Iterator[None]:
+        """self._lock for a callback. Python's lock is not fair: a stepping loop that releases and
+        retakes it at once can keep a waiting thread out for seconds (at real_time_factor 0 the
+        command queues overflowed). So a callback says it is waiting, and the loop then yields."""
+        with self._waiters_lock:
+            self._lock_waiters += 1
+        try:
+            self._lock.acquire()
+        finally:
+            with self._waiters_lock:
+                self._lock_waiters -= 1
+        try:
+            yield
+        finally:
+            self._lock.release()
+
+    def _guard(self, kind: str, counts: _CommandCounts, fn: Callable[[Any], None]) -> Callable[[Any, Any], None]:
+        """The subscription callback: count the message, run ``fn`` under the lock; an exception
+        is a rejection. Accepted = not rejected (every handler either rejects or echoes)."""
+        def wrapped(msg: Any, info: Any) -> None:
             try:
-                with self._lock:
+                self._note_sequence(counts, info.get("publication_sequence_number"))
+            except Exception as exc:  # the graph query; the command itself is still handled
+                self._warn(f"{kind}:sequence", f"{kind}: cannot check the sequence number: {exc}")
+            with self._executor_lock():
+                counts.received += 1
+                before = self.rejected
+                try:
                     fn(msg)
-            except Exception as exc:  # nothing a peer sends may stop the simulation
-                self._reject(f"{kind}:exception", f"{kind} command failed: {type(exc).__name__}: {exc}")
+                except Exception as exc:  # nothing a peer sends may stop the simulation
+                    self._reject(f"{kind}:exception", f"{kind} command failed: {type(exc).__name__}: {exc}")
+                if self.rejected != before:
+                    counts.rejected += 1
+                else:
+                    counts.accepted += 1
         return wrapped
+
+    def _note_sequence(self, counts: _CommandCounts, seq: Any) -> None:
+        """Count the messages DDS dropped before the node took them (a full depth-10 queue, or the
+        publisher's own history overwritten before delivery): a gap in the publisher's sequence
+        numbers. The rmw does not say which publisher sent a message, so a gap is only counted when
+        the topic has a single publisher, the same one as for the previous message (a graph query,
+        only on a gap: a new publisher starts its own numbering)."""
+        if not isinstance(seq, int) or seq <= 0:
+            return  # an rmw without publication sequence numbers
+        if seq == counts.last_seq + 1:
+            counts.last_seq = seq
+            return
+        infos = self.get_publishers_info_by_topic(counts.topic)
+        writer = tuple(infos[0].endpoint_gid) if len(infos) == 1 else None
+        if writer is not None and writer == counts.writer and seq > counts.last_seq + 1:
+            counts.lost += seq - counts.last_seq - 1
+        counts.writer, counts.last_seq = writer, seq
 
     def _guard_srv(self, kind: str, fn: Callable[[Any, Any], Any]) -> Callable[[Any, Any], Any]:
         def wrapped(req: Any, resp: Any) -> Any:
             try:
-                with self._lock:
+                with self._executor_lock():
                     return fn(req, resp)
             except Exception as exc:
                 msg = f"{kind} failed: {type(exc).__name__}: {exc}"
@@ -497,9 +604,8 @@ class SimNode(Node):
             return
         if self._cmd_vel_sub is not None:
             self.destroy_subscription(self._cmd_vel_sub)
-        self._cmd_vel_sub = self.create_subscription(
-            TwistStamped if stamped else Twist, "cmd_vel", self._guard("cmd_vel", self._on_cmd_vel), qos.COMMAND,
-            qos_overriding_options=self._overrides)
+        self._cmd_vel_sub = self._subscribe(TwistStamped if stamped else Twist, "cmd_vel", "cmd_vel",
+                                            self._on_cmd_vel, qos_overriding_options=self._overrides)
         self._cmd_vel_sub_stamped = stamped
 
     # ================================================================== services
@@ -635,7 +741,7 @@ class SimNode(Node):
         return SetParametersResult(successful=True)
 
     def _post_set_parameters(self, plist: list[Parameter]) -> None:
-        with self._lock:
+        with self._executor_lock():
             self._post_set_locked(plist)
 
     def _post_set_locked(self, plist: list[Parameter]) -> None:
@@ -812,14 +918,23 @@ class SimNode(Node):
         c = self.world.contacts
         if len(c):
             hits = c[c["kind"] == collide.COLLISION]
-            if len(hits) and self._pending_count < MAX_PENDING_COLLISIONS:
+            room = MAX_CONTACTS_PER_MESSAGE - self._pending_count
+            if len(hits) > room:
+                self.dropped_contacts += len(hits) - room
+                hits = hits[:room]
+            if len(hits):
                 self._pending.append(hits.copy())
                 self._pending_count += len(hits)
 
     def _take_contacts(self) -> np.ndarray:
-        """Impacts since the last publish, then the resting contacts of the current step."""
+        """Impacts since the last publish, then the resting contacts of the current step (at most
+        MAX_CONTACTS_PER_MESSAGE in all)."""
         c = self.world.contacts
         resting = c[c["kind"] != collide.COLLISION]
+        room = MAX_CONTACTS_PER_MESSAGE - self._pending_count
+        if len(resting) > room:
+            self.dropped_contacts += len(resting) - room
+            resting = resting[:room]
         parts = [*self._pending, resting]
         self._pending = []
         self._pending_count = 0
@@ -863,7 +978,9 @@ class SimNode(Node):
             "dynamic_bodies": str(len(self._dyn_names)), "contacts": str(len(self.world.contacts)),
             "sim_time": f"{sim:.6f}", "paused": str(self._paused).lower(),
             "rejected_commands": str(self.rejected), "last_rejection": self.last_rejection,
+            "dropped_contacts": str(self.dropped_contacts),
         }
+        vals.update(self._count_values())
         st.values = [KeyValue(key=k, value=v) for k, v in vals.items()]
         msg = DiagnosticArray()
         sec, ns = self._stamp()
@@ -873,6 +990,17 @@ class SimNode(Node):
         self._diag_wall, self._diag_cpu, self._diag_sim = wall, cpu, sim
         self._step_time_sum = self._step_time_max = self._pub_time_sum = 0.0
         self._window_steps = 0
+
+    def _count_values(self) -> dict[str, str]:
+        """published/<topic> for every publisher (published/diagnostics: the ones before this message),
+        then received/, accepted/, rejected/, lost/<topic> for every command topic (docs/ros_interface.md)."""
+        vals = {f"published/{k}": str(p.count) for k, p in sorted(self._published.items())}
+        for topic, c in sorted(self._commands.items()):
+            vals[f"received/{topic}"] = str(c.received)
+            vals[f"accepted/{topic}"] = str(c.accepted)
+            vals[f"rejected/{topic}"] = str(c.rejected)
+            vals[f"lost/{topic}"] = str(c.lost)
+        return vals
 
     # ================================================================== main loop
     def _spin(self, ex: SingleThreadedExecutor) -> None:
@@ -927,10 +1055,11 @@ class SimNode(Node):
                         continue
                     self.step_once()
                 ref_steps += 1
-                if rtf <= 0:
-                    # Flat out, this loop would take the lock back at once: Python's lock is not fair,
-                    # so the executor thread could starve long enough for the command queues to
-                    # overflow. Yielding the GIL hands the lock over when the executor is waiting.
+                if self._lock_waiters:
+                    # A callback waits for the lock (_executor_lock). Without sleeping this loop would
+                    # take it back at once (flat out at real_time_factor 0, or catching up), so sleep
+                    # long enough for the waiting thread to get it. Only then: time.sleep(0) costs
+                    # ~80 us here (an actual timer sleep), more than a step of a small scene.
                     time.sleep(0)
         except KeyboardInterrupt:
             pass

@@ -31,6 +31,9 @@ SPECS: tuple[Spec, ...] = (
     Spec("time_step", 0.001, "Physics time step (s)", 1e-5, 0.1),
     Spec("real_time_factor", 1.0, "Simulated seconds per wall second; 0 = as fast as possible", 0.0, 100.0),
     Spec("state_rate", 100.0, "Rate (Hz of sim time) of bodies/poses, bodies/states, contacts, energy", 1.0, 10000.0),
+    Spec("state_qos_depth", 100, "History depth (KEEP_LAST, reliable) of the publishers of bodies/poses, "
+         "bodies/states, contacts and energy: how many messages a subscriber may fall behind before it loses "
+         "the oldest; read-only (set at start)", 1, 10000, read_only=True),
     Spec("tf_rate", 50.0, "Rate (Hz of sim time) of /tf; 0 = off", 0.0, 10000.0),
     Spec("marker_rate", 20.0, "Rate (Hz of sim time) of markers; 0 = off", 0.0, 1000.0),
     Spec("clock_rate", 1000.0, "Rate (Hz of sim time) of /clock, at most every step", 1.0, 100000.0),

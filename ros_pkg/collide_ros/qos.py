@@ -3,9 +3,14 @@ from __future__ import annotations
 
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 
-# Poses, states, contacts, energy: a slow subscriber loses old samples, never blocks the sim.
-STATE = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=10, reliability=ReliabilityPolicy.RELIABLE,
-                   durability=DurabilityPolicy.VOLATILE)
+
+def state(depth: int) -> QoSProfile:
+    """Poses, states, contacts, energy: a slow subscriber loses old samples, never blocks the sim.
+    ``depth`` is the node parameter state_qos_depth (docs/ros_interface.md)."""
+    return QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=depth, reliability=ReliabilityPolicy.RELIABLE,
+                      durability=DurabilityPolicy.VOLATILE)
+
+
 # Commands: what teleop_twist_keyboard, `ros2 topic pub` and turtlesim use.
 COMMAND = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=10, reliability=ReliabilityPolicy.RELIABLE,
                      durability=DurabilityPolicy.VOLATILE)

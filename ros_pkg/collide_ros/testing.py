@@ -74,6 +74,24 @@ class NodeProcess:
         return int(self.proc.returncode)
 
 
+COUNT_PREFIXES = ("published/", "received/", "accepted/", "rejected/", "lost/")
+
+
+def diag_values(msg: Any, name: str = "sim") -> dict[str, str] | None:
+    """The values of the ``<name>: physics`` status of a DiagnosticArray (None if it has none)."""
+    for st in msg.status:
+        if st.name == f"{name}: physics":
+            return {kv.key: kv.value for kv in st.values}
+    return None
+
+
+def diag_counts(values: dict[str, str]) -> dict[str, int]:
+    """The message counts among diagnostics values (docs/ros_interface.md, /diagnostics), with
+    rejected_commands (every rejection, also of a failed physics step) and dropped_contacts."""
+    return {k: int(v) for k, v in values.items()
+            if k.startswith(COUNT_PREFIXES) or k in ("rejected_commands", "dropped_contacts")}
+
+
 def _param_value(v: Any) -> ParameterValue:
     pv = ParameterValue()
     if isinstance(v, bool):
@@ -169,6 +187,36 @@ class SimClient:
             return None
         self.wait_for(lambda: find() is not None, timeout)
         return find()
+
+    def diagnostics(self, timeout: float = 10.0) -> dict[str, str] | None:
+        """The values of the node's next /diagnostics status (None on timeout)."""
+        end = time.monotonic() + timeout
+        while time.monotonic() < end:
+            msg = self.fresh("diagnostics", timeout=max(0.0, end - time.monotonic()))
+            vals = None if msg is None else diag_values(msg, self.sim.rsplit("/", 1)[-1])
+            if vals is not None:
+                return vals
+        return None
+
+    def settled_counts(self, timeout: float = 20.0) -> dict[str, int] | None:
+        """The node's message counts once they stopped changing: two consecutive /diagnostics
+        messages of a paused node with equal counts, apart from published/diagnostics (the node
+        builds diagnostics under the same lock as it publishes and takes commands, so nothing
+        was published or taken between them). Pause the node first."""
+        end = time.monotonic() + timeout
+        prev: dict[str, int] | None = None
+        while time.monotonic() < end:
+            vals = self.diagnostics(timeout=max(0.0, end - time.monotonic()))
+            if vals is None:
+                return None
+            counts = diag_counts(vals) if vals.get("paused") == "true" else None
+            same = (counts is not None and prev is not None
+                    and {k: v for k, v in counts.items() if k != "published/diagnostics"}
+                    == {k: v for k, v in prev.items() if k != "published/diagnostics"})
+            if same:
+                return counts
+            prev = counts
+        return None
 
     def sim_time(self, timeout: float = 10.0) -> float | None:
         msg = self.fresh("clock", timeout=timeout)

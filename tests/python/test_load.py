@@ -48,6 +48,17 @@ def test_flood_really_was_10khz(phases: dict[str, Phase]) -> None:
     assert ph.rate_hz >= 0.5 * RATE
     # whatever got through the depth-10 command queue was accepted and echoed, none rejected
     assert 0 < ph.accepted <= ph.sent and ph.rejected_during == 0
+    # The node's own counts (/diagnostics): every flood message was either taken (and accepted,
+    # and echoed) or counted lost, a gap in the publisher's sequence numbers after the first message
+    # the node took (sent before the flood). Exact: a reliable writer delivers its last sample, so
+    # the last sequence number reaches the node; between the first and the last every number is
+    # taken or in a gap.
+    c = ph.node_counts
+    assert c["received"] + c["lost"] == ph.sent, c
+    assert c["accepted"] == c["received"] and c["rejected"] == 0, c
+    # the echoes this client got: at most the accepted ones (the echo writer's depth 10 may drop some
+    # while this flooding process is descheduled)
+    assert 0 < ph.accepted <= c["accepted"]
 
 
 def test_spam_was_answered(phases: dict[str, Phase]) -> None:

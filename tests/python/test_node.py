@@ -96,6 +96,9 @@ def test_publishes_everything(sim: SimClient) -> None:
     diag = sim.fresh("diagnostics", timeout=5.0)
     values = {kv.key: kv.value for kv in diag.status[0].values}
     assert float(values["real_time_factor"]) > 0.0 and float(values["step_time_mean_ms"]) > 0.0
+    # message counts (test_node_diagnostics.py checks them against a subscriber)
+    assert int(values["published/bodies/states"]) > 0 and int(values["published/clock"]) > 0
+    assert {f"{w}/block2/thrust" for w in ("received", "accepted", "rejected", "lost")} <= values.keys()
 
 
 def test_thrust_lasts_command_timeout(sim: SimClient) -> None:
@@ -319,6 +322,12 @@ def test_bad_input_rejected_while_simulating(sim: SimClient) -> None:
     diag = sim.fresh("diagnostics", timeout=5.0)
     values = {kv.key: kv.value for kv in diag.status[0].values}
     assert int(values["rejected_commands"]) >= len(expected)
+    # counted per command topic too (earlier tests' rejections add to these)
+    at_least = {"block1/thrust": 1, "block2/thrust": 1, "thrusters": 2, "spring": 3, "cmd_vel": 1}
+    for topic, n in at_least.items():
+        assert int(values[f"rejected/{topic}"]) >= n, topic
+        assert int(values[f"received/{topic}"]) == (int(values[f"accepted/{topic}"])
+                                                    + int(values[f"rejected/{topic}"])), topic
 
 
 def test_blocks_apply_on_reset(sim: SimClient) -> None:
