@@ -65,6 +65,9 @@ class SoakResult:
     param_sets: int = 0
     published: dict[str, int] = field(default_factory=dict)
     recorded: dict[str, int] = field(default_factory=dict)
+    # the same counts from the node's own /diagnostics (published/<topic>), read at the same two
+    # pauses: recorded beside the wrapper's to find where they differ (docs/hardening.md), not judged
+    published_diagnostics: dict[str, int] = field(default_factory=dict)
     states_checked: int = 0
     max_abs_centre: float = 0.0
     non_finite: int = 0
@@ -244,7 +247,7 @@ def run_soak(duration: float, out: Path, seed: int = 1, state_rate: float = 10.0
     rec: subprocess.Popen[bytes] | None = None
     ctx = rclpy.Context()
     rclpy.init(context=ctx)
-    client = SimClient(context=ctx, watch=("bodies/states",))
+    client = SimClient(context=ctx, watch=("bodies/states", "diagnostics"))
     rng = random.Random(seed)
     drv = Driver(client, rng)
     try:
@@ -272,6 +275,7 @@ def run_soak(duration: float, out: Path, seed: int = 1, state_rate: float = 10.0
                     raise RuntimeError(f"soak: node not subscribed to {topic}")
         client.spin(1.0)  # the node's writers match the recorder's readers (discovery both ways)
         before = _snapshot(node, counts_file, 1)
+        before_diag = client.settled_counts(timeout=30.0) or {}
         if client.call(SetBool, "pause", SetBool.Request(data=False)) is None:
             raise RuntimeError("soak: ~/pause failed")
         t_start = time.monotonic()
@@ -328,12 +332,15 @@ def run_soak(duration: float, out: Path, seed: int = 1, state_rate: float = 10.0
         res.duration_s = time.monotonic() - t_start
         client.spin(3.0)  # the recorder drains what is in flight
         after = _snapshot(node, counts_file, 2)
+        after_diag = client.settled_counts(timeout=30.0) or {}
         last = client.fresh("bodies/states", timeout=0.1) or client.last.get("bodies/states")
         if last is not None and sim_t0 is not None:
             res.sim_time_s = last.header.stamp.sec + 1e-9 * last.header.stamp.nanosec - sim_t0
         rec.send_signal(signal.SIGINT)
         rec.wait(60)
         res.published = {t: after.get(t, 0) - before.get(t, 0) for t in recorded_topics()}
+        res.published_diagnostics = {t: after_diag.get(f"published/{t.lstrip('/')}", 0)
+                                     - before_diag.get(f"published/{t.lstrip('/')}", 0) for t in recorded_topics()}
         res.commands_sent = dict(drv.sent)
         check_bag(bag, res)
         res.rss_growth_mib = (max(rss_after_warm) - rss_after_warm[0]) if len(rss_after_warm) > 1 else 0.0

@@ -74,65 +74,64 @@ static int solve_block_friction(lc_world *w, double *state, lc_touch *t, int n, 
     return hits;
 }
 
+/* Most alternations between the normal and the friction rows of a large impact. */
+#define LC_IMPULSE_FRICTION_ROUNDS 4
+
 /* The impulse problem of a large group (more touches than lcp_exact_max: an impact into a pile, the
- * inelastic pass closing a jam) by projected Gauss-Seidel in body space: each touch's impulse updates
- * its two bodies' velocity changes at once, so a sweep costs O(touches) and memory O(bodies +
- * touches) instead of a dense n x n matrix (7000 touches of a base-50 pyramid: 392 MB). Same model as
- * the small problem: compression impulses (tangent rows stop the sliding within |j_t| <= mu j_n),
- * then (1 + e) times the normal ones. */
+ * inelastic pass closing a jam) by MPRGP on the sparse response (sparse_lcp.c): O(touches) memory and
+ * work per product instead of a dense n x n matrix (7000 touches of a base-50 pyramid: 392 MB). Same
+ * model as the small problem: compression impulses, the tangent rows (stopping the sliding within
+ * |j_t| <= mu j_n) alternated with the normal ones, then (1 + e) times the normal ones. Converged when
+ * no point is left approaching faster than a thousandth of resting_speed, well inside what the
+ * resting test treats as at rest. */
 static int solve_block_sparse(lc_world *w, double *state, lc_touch *t, int n, int restitute)
 {
-    double *dv = lc_buf_get(&w->b_fric, ((size_t)w->count * 3 + (size_t)n * 6) * sizeof(double));
-    double *jn, *jt, *dn, *dt, *vn0, *vt0, vmax = 0.0, tol;
-    int i, sweep, hits = 0, sweeps = w->def.lcp_max_iterations > 1000 ? w->def.lcp_max_iterations : 1000;
-    if (dv == NULL) return -1;
-    jn = dv + (size_t)w->count * 3;
-    jt = jn + n; dn = jt + n; dt = dn + n; vn0 = dt + n; vt0 = vn0 + n;
-    memset(dv, 0, (size_t)w->count * 3 * sizeof(double));
+    double *v = lc_buf_get(&w->b_fric, (size_t)n * 8 * sizeof(double));
+    double *body = lc_buf_get(&w->b_dacc, (size_t)w->count * 3 * sizeof(double));
+    double *jn, *jt, *vn0, *vt0, *lo, *hi, *rhs, *jt_old, tol, viol = 0.0;
+    int i, round, k, hits = 0, with_friction = 0, budget = 5 * w->def.lcp_max_iterations;
+    if (v == NULL || body == NULL) return -1;
+    jn = v; jt = jn + n; vn0 = jt + n; vt0 = vn0 + n; lo = vt0 + n; hi = lo + n; rhs = hi + n; jt_old = rhs + n;
+    tol = 1e-3 * w->def.resting_speed;
     for (i = 0; i < n; ++i) {
-        lc_vec2 tg = lc_tangent_of(t[i].n);
         const double *sa = &state[t[i].a * 6], *sb = &state[t[i].b * 6];
         lc_vec2 rel = lc_sub(lc_add(lc_v(sa[SVX], sa[SVY]), lc_wcross(sa[SW], t[i].ra)),
                              lc_add(lc_v(sb[SVX], sb[SVY]), lc_wcross(sb[SW], t[i].rb)));
         jn[i] = jt[i] = 0.0;
-        dn[i] = lc_response_dir(w, &t[i], t[i].n, &t[i], t[i].n);
-        dt[i] = lc_response_dir(w, &t[i], tg, &t[i], tg);
         vn0[i] = lc_dot(t[i].n, rel);
-        vt0[i] = lc_dot(tg, rel);
-        if (fabs(vn0[i]) > vmax) vmax = fabs(vn0[i]);
+        vt0[i] = lc_dot(lc_tangent_of(t[i].n), rel);
+        if (t[i].friction > 0.0) with_friction = 1;
     }
-    /* converged when no impulse changes any velocity by more than round-off of the impact speed */
-    tol = 1e-12 * (1.0 + vmax);
-    for (sweep = 0; sweep < sweeps; ++sweep) {
-        double change = 0.0;
+    for (round = 0; round < (with_friction ? LC_IMPULSE_FRICTION_ROUNDS : 1); ++round) {
+        double moved = 0.0;
+        memset(body, 0, (size_t)w->count * 3 * sizeof(double));
+        for (i = 0; i < n; ++i)
+            if (jt[i] != 0.0) lc_touch_apply(w, &t[i], lc_scale(lc_tangent_of(t[i].n), jt[i]), body, 3);
         for (i = 0; i < n; ++i) {
-            lc_vec2 tg = lc_tangent_of(t[i].n);
-            double v, next, d;
-            if (!(dn[i] > 0.0)) continue;
-            v = vn0[i] + lc_response_push(w, &t[i], t[i].n, dv);
-            next = jn[i] - v / dn[i];
-            if (!(next > 0.0)) next = 0.0;
-            d = next - jn[i];
-            if (d != 0.0) {
-                lc_touch_apply(w, &t[i], lc_scale(t[i].n, d), dv, 3);
-                jn[i] = next;
-                if (fabs(d) * dn[i] > change) change = fabs(d) * dn[i];
-            }
-            if (t[i].friction > 0.0 && dt[i] > 0.0) {
-                double lim = t[i].friction * jn[i];
-                v = vt0[i] + lc_response_push(w, &t[i], tg, dv);
-                next = jt[i] - v / dt[i];
-                if (next > lim) next = lim;
-                if (next < -lim) next = -lim;
-                d = next - jt[i];
-                if (d != 0.0) {
-                    lc_touch_apply(w, &t[i], lc_scale(tg, d), dv, 3);
-                    jt[i] = next;
-                    if (fabs(d) * dt[i] > change) change = fabs(d) * dt[i];
-                }
-            }
+            rhs[i] = vn0[i] + lc_response_push(w, &t[i], t[i].n, body);
+            lo[i] = 0.0;
+            hi[i] = INFINITY;
         }
-        if (change <= tol) break;
+        k = lc_sparse_lcp(w, t, n, 0, rhs, lo, hi, jn, tol, budget, &viol);
+        if (k < 0) return -1;
+        if (!with_friction) break;
+        memset(body, 0, (size_t)w->count * 3 * sizeof(double));
+        for (i = 0; i < n; ++i)
+            if (jn[i] != 0.0) lc_touch_apply(w, &t[i], lc_scale(t[i].n, jn[i]), body, 3);
+        for (i = 0; i < n; ++i) {
+            rhs[i] = vt0[i] + lc_response_push(w, &t[i], lc_tangent_of(t[i].n), body);
+            hi[i] = t[i].friction * jn[i];
+            lo[i] = -hi[i];
+            jt_old[i] = jt[i];
+        }
+        k = lc_sparse_lcp(w, t, n, 1, rhs, lo, hi, jt, tol, budget, &viol);
+        if (k < 0) return -1;
+        memset(body, 0, (size_t)w->count * 3 * sizeof(double));
+        for (i = 0; i < n; ++i)
+            if (jt[i] != jt_old[i])
+                lc_touch_apply(w, &t[i], lc_scale(lc_tangent_of(t[i].n), jt[i] - jt_old[i]), body, 3);
+        for (i = 0; i < n; ++i) moved = fmax(moved, fabs(lc_response_push(w, &t[i], t[i].n, body)));
+        if (moved <= tol) break;
     }
     w->last.impulse_solves++;
     for (i = 0; i < n; ++i) {

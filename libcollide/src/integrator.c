@@ -62,6 +62,7 @@ int lc_integrate(lc_world *w, const double *s0, double h, const int *rows, int n
     acc = lc_buf_get(&w->b_acc, (size_t)w->count * 3 * sizeof(double));
     if (!flags || !irows || !acc) return -1;
     if (s1 != s0) memcpy(s1, s0, bytes);
+    if (h == 0.0) return 0;   /* no time passes: no force evaluation (a pile's is a full contact solve) */
     memset(flags, 0, (size_t)w->count * sizeof(int));
     for (i = 0; i < nt; ++i) flags[touches[i].a] = flags[touches[i].b] = 1;
     for (i = 0; i < nrows; ++i) {

@@ -42,9 +42,15 @@ static int gather_touches(lc_world *w, const double *state, lc_buf *buf)
 
 static int push_contact(lc_world *w, const lc_touch *t, lc_contact_kind kind);
 
-/* Resting set: touching points that neither approach nor separate faster than resting_speed.
- * Touches already inside the contact gap that still approach faster than that are impacts that no
- * crossing test can see any more (they start inside); they are resolved here, before the step. */
+/* Keys of a vertex against a body, and of a touch (vertex and edge), for the hash tables below. */
+static uint32_t vertex_key(const lc_world *w, int a, int vertex, int b)
+{
+    uint32_t h = 2166136261u;
+    h = (h ^ w->ids[a]) * 16777619u;
+    h = (h ^ (uint32_t)vertex) * 16777619u;
+    return (h ^ w->ids[b]) * 16777619u;
+}
+
 static uint32_t touch_key(const lc_world *w, const lc_touch *t)
 {
     uint32_t h = 2166136261u;
@@ -89,6 +95,9 @@ static int warm_start(lc_world *w, lc_touch *t, int n)
     return 0;
 }
 
+/* Resting set: touching points that neither approach nor separate faster than resting_speed.
+ * Touches already inside the contact gap that still approach faster than that are impacts that no
+ * crossing test can see any more (they start inside); they are resolved here, before the step. */
 static int gather_resting(lc_world *w, double *state, int *impacts, const uint8_t *marked, const int *list,
                           int nlist)
 {
@@ -97,8 +106,11 @@ static int gather_resting(lc_world *w, double *state, int *impacts, const uint8_
     n = gather_touches_of(w, state, marked, list, nlist, &w->b_touch);
     t = (lc_touch *)w->b_touch.p;
     if (n < 0) return -1;
+    /* within the time-of-impact tolerance of the gap counts as at the gap, as it does for a crossing
+     * (whose time of impact would be 0): all of them are resolved here in one group, not one pass each */
     for (i = 0; i < n; ++i)
-        if (t[i].gap <= w->def.contact_gap && t[i].vn < -w->def.resting_speed) urgent = 1;
+        if (t[i].gap <= w->def.contact_gap + w->def.toi_distance_tolerance && t[i].vn < -w->def.resting_speed)
+            urgent = 1;
     if (urgent) {
         lc_touch *x = lc_buf_get(&w->b_impact, (size_t)n * sizeof(lc_touch));
         if (x == NULL) return -1;
@@ -258,41 +270,33 @@ static void add_counters(lc_counters *total, const lc_counters *last)
  * push faces that start touching apart at ~contact_gap/h, and a push-only force cannot brake that).
  * Crossings must start above half the gap's depth, so this is also the backstop that keeps drift in
  * a jammed pile from becoming an overlap nothing can see: no step ends overlapping. */
-/* The projection of a large group (more touches than lcp_exact_max: a pile) by projected Gauss-Seidel
- * in body space: each touch's push updates the two bodies' displacements at once, so a sweep costs
- * O(touches) and memory O(bodies + touches), where the dense problem would be O(touches^2) (a
- * 210-box pyramid starting with its faces at gap 0 has ~1200 touches: 11 MB and seconds per pass). */
-#define LC_PROJECTION_SWEEPS 1000
+/* The projection of a large group (more touches than lcp_exact_max: a pile) by MPRGP on the sparse
+ * response (sparse_lcp.c): O(touches) memory and per product where the dense problem would be
+ * O(touches^2) (a 210-box pyramid starting with its faces at gap 0 has ~1200 touches: 11 MB and
+ * seconds per pass). Converged when no gap is off by more than a thousandth of the contact gap. Its
+ * budget is 5x the force solve's: it is the last line before a step fails, and a cold 5050-box
+ * pyramid (100 layers lifted to the gap at once) needed more than 1000 products per pass. */
 static int project_sparse(lc_world *w, const lc_touch *t, int n)
 {
     double *disp = lc_buf_get(&w->b_vec, (size_t)w->count * 3 * sizeof(double));
-    double *lam = lc_buf_get(&w->b_vec2, (size_t)n * 2 * sizeof(double)), *diag;
-    /* converged when no push changes any gap by more than a thousandth of the contact gap */
-    double tol = 1e-3 * w->def.contact_gap;
-    int i, sweep;
+    double *lam = lc_buf_get(&w->b_vec2, (size_t)n * 4 * sizeof(double)), *b, *lo, *hi, viol;
+    int i;
     if (!disp || !lam) return -1;
-    diag = lam + n;
-    memset(disp, 0, (size_t)w->count * 3 * sizeof(double));
+    b = lam + n;
+    lo = b + n;
+    hi = lo + n;
     for (i = 0; i < n; ++i) {
         lam[i] = 0.0;
-        diag[i] = lc_response_dir(w, &t[i], t[i].n, &t[i], t[i].n);
+        b[i] = t[i].gap - w->def.contact_gap;
+        lo[i] = 0.0;
+        hi[i] = INFINITY;
     }
-    for (sweep = 0; sweep < LC_PROJECTION_SWEEPS; ++sweep) {
-        double change = 0.0;
-        for (i = 0; i < n; ++i) {
-            double r, next, d;
-            if (!(diag[i] > 0.0)) continue;
-            r = t[i].gap - w->def.contact_gap + lc_response_push(w, &t[i], t[i].n, disp);
-            next = lam[i] - r / diag[i];
-            if (!(next > 0.0)) next = 0.0;
-            d = next - lam[i];
-            if (d == 0.0) continue;
-            lc_touch_apply(w, &t[i], lc_scale(t[i].n, d), disp, 3);
-            lam[i] = next;
-            if (fabs(d) * diag[i] > change) change = fabs(d) * diag[i];
-        }
-        if (change <= tol) break;
-    }
+    if (lc_sparse_lcp(w, t, n, 0, b, lo, hi, lam, 1e-3 * w->def.contact_gap, 25 * w->def.lcp_max_iterations,
+                      &viol) < 0)
+        return -1;
+    memset(disp, 0, (size_t)w->count * 3 * sizeof(double));
+    for (i = 0; i < n; ++i)
+        if (lam[i] > 0.0 && isfinite(lam[i])) lc_touch_apply(w, &t[i], lc_scale(t[i].n, lam[i]), disp, 3);
     for (i = 0; i < w->count; ++i) {
         w->state[i * 6 + SX] += disp[i * 3 + 0];
         w->state[i * 6 + SY] += disp[i * 3 + 1];
@@ -379,16 +383,24 @@ static double circle_gap(const lc_world *w, const double *s, int a, int b)
 /* Vertices that dip into another body and come back out within the interval are invisible to the
  * end-point test. For pairs that end up closer than their chords can stray, the two bodies' motion is
  * sampled at LC_SWEEP_SAMPLES sub-times and every sub-interval is tested; a crossing found there
- * carries the sub-time by which it is inside as the upper end of its time-of-impact bracket. */
+ * carries the sub-time by which it is inside as the upper end of its time-of-impact bracket.
+ * A coupled pair (touching others, or tied by a spring) moves with the whole world, whose sub-time
+ * states are computed once per interval and shared by every such pair: in a pile each of them costs
+ * a contact-force solve of the whole pile per integrator stage, and a settling 1275-box pyramid has
+ * hundreds of near pairs in one interval. */
 #define LC_SWEEP_SAMPLES 8
 static int swept_check(lc_world *w, const double *s0, const double *s1, double h, const int *pairs, int np, int nc,
                        const int *coupled, const int *all_rows, int n_all, lc_touch *rest, int nrest)
 {
-    size_t bytes = (size_t)w->count * 6 * sizeof(double);
+    size_t count6 = (size_t)w->count * 6, bytes = count6 * sizeof(double);
+    double *own[2], *world_at = NULL;
+    int have_world[LC_SWEEP_SAMPLES] = {0};
     int p, k, i;
+    own[0] = own[1] = NULL;
     for (p = 0; p < np; ++p) {
-        int a = pairs[2 * p], b = pairs[2 * p + 1], rows[2], nr = 0, have = 0;
-        double dev, sep0, *prev, *cur;
+        int a = pairs[2 * p], b = pairs[2 * p + 1], rows[2], nr = 0, have = 0, uncoupled;
+        double dev, sep0;
+        const double *prev, *cur;
         for (i = 0; i < nc; ++i) {
             const lc_crossing *c = &((const lc_crossing *)w->b_cross.p)[i];
             if ((c->a == a && c->b == b) || (c->a == b && c->b == a)) have = 1;
@@ -397,6 +409,9 @@ static int swept_check(lc_world *w, const double *s0, const double *s1, double h
          * corner) dipped in before that crossing's time, the pair's time of impact finds it */
         if (have) continue;
         dev = chord_deviation(w, s0, s1, h, a, b);
+        /* a path that strays from its chord by less than a quarter of the contact gap can dip at most
+         * that far past what the end-point test sees: never into the other body (a settled pile) */
+        if (dev < 0.25 * w->def.contact_gap) continue;
         /* bounding circles apart by more than the paths can stray, at both ends: nothing can dip in
          * (the circles' distance is a lower bound of the bodies' distance, as the separation is) */
         if (circle_gap(w, s0, a, b) > dev + w->def.contact_distance &&
@@ -409,22 +424,35 @@ static int swept_check(lc_world *w, const double *s0, const double *s1, double h
             continue;
         if (!w->is_static[a]) rows[nr++] = a;
         if (!w->is_static[b]) rows[nr++] = b;
-        prev = lc_buf_get(&w->b_sample0, bytes);
-        cur = lc_buf_get(&w->b_sample1, bytes);
-        if (!prev || !cur) return -1;
-        memcpy(prev, s0, bytes);
+        uncoupled = !coupled[a] && !coupled[b];
+        prev = s0;
         for (k = 1; k <= LC_SWEEP_SAMPLES; ++k) {
-            double tk = h * k / LC_SWEEP_SAMPLES, *swap;
+            double tk = h * k / LC_SWEEP_SAMPLES;
             int before = nc;
-            if (k < LC_SWEEP_SAMPLES) {
-                /* a pair in touch with others or joined by a spring moves with them: then the whole
-                 * world is advanced with its resting contacts, exactly as in the trial */
-                int uncoupled = !coupled[a] && !coupled[b];
-                if (lc_integrate(w, s0, tk, uncoupled ? rows : all_rows, uncoupled ? nr : n_all,
-                                 uncoupled ? NULL : rest, uncoupled ? 0 : nrest, cur) != 0)
-                    return -1;
+            if (k == LC_SWEEP_SAMPLES) {
+                cur = s1;
+            } else if (uncoupled) {
+                double *dst;
+                if (own[0] == NULL) {
+                    own[0] = lc_buf_get(&w->b_sample0, bytes);
+                    own[1] = lc_buf_get(&w->b_sample1, bytes);
+                    if (!own[0] || !own[1]) return -1;
+                }
+                dst = own[k & 1];   /* prev is the other one (or s0) */
+                if (lc_integrate(w, s0, tk, rows, nr, NULL, 0, dst) != 0) return -1;
+                cur = dst;
             } else {
-                memcpy(cur, s1, bytes);
+                /* the whole world advanced with its resting contacts, exactly as in the trial */
+                if (world_at == NULL) {
+                    world_at = lc_buf_get(&w->b_swept, (LC_SWEEP_SAMPLES - 1) * bytes);
+                    if (world_at == NULL) return -1;
+                }
+                if (!have_world[k]) {
+                    if (lc_integrate(w, s0, tk, all_rows, n_all, rest, nrest, world_at + (size_t)(k - 1) * count6) != 0)
+                        return -1;
+                    have_world[k] = 1;
+                }
+                cur = world_at + (size_t)(k - 1) * count6;
             }
             nc = lc_find_crossings(w, prev, cur, a, b, &w->b_cross, nc);
             if (nc < 0) return -1;
@@ -432,7 +460,7 @@ static int swept_check(lc_world *w, const double *s0, const double *s1, double h
                 for (i = before; i < nc; ++i) ((lc_crossing *)w->b_cross.p)[i].t_hi = tk;
                 break;
             }
-            swap = prev; prev = cur; cur = swap;
+            prev = cur;
         }
     }
     return nc;
@@ -454,6 +482,43 @@ static int drop_stalled(lc_world *w, const lc_crossing *stalled, int nstalled, i
         for (k = 0; k < nstalled && !skip; ++k)
             skip = stalled[k].a == c[i].a && stalled[k].b == c[i].b && stalled[k].vertex == c[i].vertex;
         if (!skip) c[kept++] = c[i];
+    }
+    return kept;
+}
+
+/* A vertex held by a resting contact force can sink below its gap by what the force solver left
+ * unresolved (a large pile, where the iterative solve stops at its sweep limit, leaves ~1e-2 m/s^2,
+ * i.e. ~1e-6 m in a 1/60 s step). That is not an impact: the force still holds the vertex, and the
+ * end-of-step projection lifts it back to the gap without touching velocities. Stopping time at it
+ * would stop at every such vertex of the pile in turn, each stop re-solving the whole pile (a
+ * 1275-box pyramid: thousands per step). A resting vertex that ends deeper than contact_distance is
+ * more than solver residual and stays an impact. */
+static int drop_resting_drift(lc_world *w, const lc_touch *rest, int nrest, const double *s1, int nc)
+{
+    lc_crossing *c = (lc_crossing *)w->b_cross.p;
+    int size = 1, i, kept = 0;
+    int *table;
+    if (nrest == 0 || nc == 0) return nc;
+    while (size < 2 * nrest) size *= 2;
+    table = lc_buf_get(&w->b_rkeys, (size_t)size * sizeof(int));
+    if (table == NULL) return -1;
+    for (i = 0; i < size; ++i) table[i] = -1;
+    for (i = 0; i < nrest; ++i) {
+        uint32_t k = vertex_key(w, rest[i].a, rest[i].vertex, rest[i].b) & (uint32_t)(size - 1);
+        while (table[k] >= 0) k = (k + 1) & (uint32_t)(size - 1);
+        table[k] = i;
+    }
+    for (i = 0; i < nc; ++i) {
+        uint32_t k = vertex_key(w, c[i].a, c[i].vertex, c[i].b) & (uint32_t)(size - 1);
+        int resting = 0;
+        while (table[k] >= 0 && !resting) {
+            const lc_touch *r = &rest[table[k]];
+            resting = r->a == c[i].a && r->vertex == c[i].vertex && r->b == c[i].b;
+            k = (k + 1) & (uint32_t)(size - 1);
+        }
+        if (resting && lc_vertex_edge_gap(w, s1, c[i].a, c[i].vertex, c[i].b, c[i].edge) > -w->def.contact_distance)
+            continue;
+        c[kept++] = c[i];
     }
     return kept;
 }
@@ -595,6 +660,8 @@ lc_status lc_world_step(lc_world *w, double dt)
             if (nc < 0) goto oom;
         }
         nc = drop_stalled(w, stalled, nstalled, nc);
+        nc = drop_resting_drift(w, rest, nrest, s1, nc);
+        if (nc < 0) goto oom;
         {
             /* a body touching nothing and tied by no spring to another body moves on its own: its
              * time-of-impact evaluations (and swept samples) need only the two bodies */
@@ -613,27 +680,42 @@ lc_status lc_world_step(lc_world *w, double dt)
         if (nc < 0) goto oom;
         cross = (lc_crossing *)w->b_cross.p;
         w->cross_count = nc;
-        /* earliest time of impact; a crossing whose gap is still open at the best time so far is later */
-        for (i = 0; i < nc; ++i) {
-            double tau;
-            int pair[2], npair = 0;
-            const int *erows = rows;
-            int nerows = nrows;
-            if (!coupled[cross[i].a] && !coupled[cross[i].b]) {
-                if (!w->is_static[cross[i].a]) pair[npair++] = cross[i].a;
-                if (!w->is_static[cross[i].b]) pair[npair++] = cross[i].b;
-                erows = pair;
-                nerows = npair;
+        /* earliest time of impact; a crossing whose gap is still open at the best time so far is later.
+         * The coupled world at that time is the same for every crossing, so it is integrated once per
+         * best time (in a pile each integration solves the whole pile's contact forces). */
+        {
+            double *world_at_best = NULL, world_t = -1.0;
+            for (i = 0; i < nc && !(best >= 0 && tmin == 0.0); ++i) {
+                double tau;
+                int pair[2], npair = 0;
+                const int *erows = rows;
+                int nerows = nrows;
+                if (!coupled[cross[i].a] && !coupled[cross[i].b]) {
+                    if (!w->is_static[cross[i].a]) pair[npair++] = cross[i].a;
+                    if (!w->is_static[cross[i].b]) pair[npair++] = cross[i].b;
+                    erows = pair;
+                    nerows = npair;
+                }
+                if (best >= 0) {
+                    double g;
+                    const double *at = scratch;
+                    if (erows != rows) {
+                        if (lc_integrate(w, s0, tmin, erows, nerows, rest, nrest, scratch) != 0) goto oom;
+                    } else {
+                        if (world_at_best == NULL && (world_at_best = lc_buf_get(&w->b_sample0, bytes)) == NULL) goto oom;
+                        if (world_t != tmin) {
+                            if (lc_integrate(w, s0, tmin, rows, nrows, rest, nrest, world_at_best) != 0) goto oom;
+                            world_t = tmin;
+                        }
+                        at = world_at_best;
+                    }
+                    g = lc_vertex_edge_gap(w, at, cross[i].a, cross[i].vertex, cross[i].b, cross[i].edge);
+                    if (g > w->def.contact_gap) continue;
+                }
+                tau = lc_time_of_impact(w, s0, fmin(tmin, cross[i].t_hi), &cross[i], erows, nerows, rest, nrest, scratch);
+                if (tau < 0.0) continue;
+                if (best < 0 || tau < tmin) { tmin = tau; best = i; }
             }
-            if (best >= 0) {
-                double g;
-                if (lc_integrate(w, s0, tmin, erows, nerows, rest, nrest, scratch) != 0) goto oom;
-                g = lc_vertex_edge_gap(w, scratch, cross[i].a, cross[i].vertex, cross[i].b, cross[i].edge);
-                if (g > w->def.contact_gap) continue;
-            }
-            tau = lc_time_of_impact(w, s0, fmin(tmin, cross[i].t_hi), &cross[i], erows, nerows, rest, nrest, scratch);
-            if (tau < 0.0) continue;
-            if (best < 0 || tau < tmin) { tmin = tau; best = i; }
         }
         if (best < 0) {
             local_next = 0;

@@ -98,6 +98,12 @@ struct lc_world {
     lc_buf b_touch, b_rest, b_pairs, b_aabb, b_rows, b_island, b_flags, b_mat, b_vec, b_vec2, b_order;
     lc_buf b_step_scratch;   /* step.c only: held across the whole step, so no other file may use it */
     lc_buf b_sample0, b_sample1; /* step.c only: sub-interval states of the swept check */
+    lc_buf b_swept;
+    lc_buf b_rkeys;
+    lc_buf b_sparse, b_sparse_body; /* sparse_lcp.c: its vectors and the bodies' responses */
+    double sparse_norm[2];   /* sparse_lcp.c: last ||A|| estimate of normal [0] and tangent [1] rows, */
+    int sparse_norm_rows[2]; /* and its row count: a pile's A changes little from one solve to the next */
+    lc_buf b_group_rows;     /* contact_forces.c: right-hand sides, bounds and forces of a large group */          /* step.c only: hash of the resting vertices of a pass */          /* step.c only: the whole world at the swept check's sub-times */
     lc_buf b_dirty, b_drows; /* step.c only: bodies whose motion the last impact changed */
     lc_buf b_group;          /* step.c only: bodies of an impact group, in the order found */
     int cross_count;         /* step.c only: crossings in b_cross at the end of the last pass */
@@ -175,6 +181,13 @@ void lc_touch_apply(const lc_world *w, const lc_touch *t, lc_vec2 push, double *
 double lc_response_push(const lc_world *w, const lc_touch *t, lc_vec2 d, const double *acc);
 /* Tangent of a contact normal (the direction of friction rows and tangent impulses). */
 static inline lc_vec2 lc_tangent_of(lc_vec2 n) { return lc_v(-n.y, n.x); }
+
+/* ---- sparse_lcp.c ---- */
+/* MPRGP on min 1/2 x'Ax + b'x, lo <= x <= hi, with A = J M^-1 J' of the touches' normal (or, with
+ * tangent != 0, tangent) rows, never formed. x: start and answer. Returns products of A used (-1: no
+ * memory); *violation = largest entry of the projected gradient (units of b). */
+int lc_sparse_lcp(lc_world *w, const lc_touch *t, int m, int tangent, const double *b, const double *lo,
+                  const double *hi, double *x, double tol, int max_products, double *violation);
 
 /* ---- contact_forces.c ---- */
 /* Adds resting contact forces for touches[0..n) into acc (rows indexed), solving the contact LCP.

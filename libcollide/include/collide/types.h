@@ -201,10 +201,11 @@ typedef struct lc_counters {
     uint64_t inelastic_fallbacks;     /* events closed by the inelastic simultaneous pass */
     uint64_t resting_contacts;        /* resting contact points in contact solves */
     uint64_t contact_solves;          /* complementarity solves for contact forces */
-    uint64_t contact_solve_iterations;/* pivots or sweeps in those solves */
+    uint64_t contact_solve_iterations;/* pivots, or products of the response matrix (large groups), in those solves */
     uint64_t impulse_solves;          /* complementarity solves for impulses */
     uint64_t position_projections;    /* end-of-step corrections of points found inside another body */
-    double max_lcp_residual;          /* largest complementarity residual of the iterative solver */
+    double max_lcp_residual;          /* largest residual of an iterative contact-force solve: relative for
+                                         groups up to lcp_exact_max, m/s^2 of relative acceleration above */
 } lc_counters;
 
 #endif /* COLLIDE_TYPES_H */
