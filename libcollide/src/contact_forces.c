@@ -201,7 +201,7 @@ static int solve_large_group(lc_world *w, const double *state, lc_touch *sub, in
 
 int lc_contact_forces(lc_world *w, const double *state, lc_touch *touches, int n, double *acc)
 {
-    int *parent, *order, *group;
+    int *parent, *order, *group, *start;
     int i, g0, rows = w->count;
     double h = w->step_dt > 0.0 ? w->step_dt : 1e-3;
     double kv = 0.0, kd = 0.0;
@@ -215,10 +215,11 @@ int lc_contact_forces(lc_world *w, const double *state, lc_touch *touches, int n
     opt.tolerance = w->def.lcp_tolerance;
     opt.regularization = 1e-12;
 
-    parent = lc_buf_get(&w->b_island, (size_t)(rows + 2 * n) * sizeof(int));
+    parent = lc_buf_get(&w->b_island, (size_t)(2 * rows + 1 + 2 * n) * sizeof(int));
     if (parent == NULL) return -1;
     order = parent + rows;
     group = order + n;
+    start = group + n;
     for (i = 0; i < rows; ++i) parent[i] = i;
     for (i = 0; i < n; ++i) {
         lc_touch *t = &touches[i];
@@ -231,14 +232,14 @@ int lc_contact_forces(lc_world *w, const double *state, lc_touch *touches, int n
     for (i = 0; i < n; ++i) {
         lc_touch *t = &touches[i];
         group[i] = find(parent, w->is_static[t->a] ? t->b : t->a);
-        order[i] = i;
     }
-    /* stable insertion sort of touch indices by group keeps the original order inside a group */
-    for (i = 1; i < n; ++i) {
-        int v = order[i], j = i - 1;
-        while (j >= 0 && group[order[j]] > group[v]) { order[j + 1] = order[j]; --j; }
-        order[j + 1] = v;
-    }
+    /* touch indices by group (a counting sort on the group's root row: O(touches + bodies), where an
+     * insertion sort was O(touches^2) for thousands of boxes each alone on a floor), in their
+     * original order inside a group */
+    for (i = 0; i <= rows; ++i) start[i] = 0;
+    for (i = 0; i < n; ++i) start[group[i] + 1]++;
+    for (i = 0; i < rows; ++i) start[i + 1] += start[i];
+    for (i = 0; i < n; ++i) order[start[group[i]]++] = i;
     for (g0 = 0; g0 < n;) {
         int g1 = g0, m, j;
         double *A, *b, *f;
