@@ -466,6 +466,117 @@ static int swept_check(lc_world *w, const double *s0, const double *s1, double h
     return nc;
 }
 
+/* Islands: bodies joined by resting touches or by springs between bodies move together, and apart
+ * from every other island (static bodies join nothing: they transmit no motion). A time-of-impact
+ * search needs only the islands of the crossing's two bodies; integrating the whole world there made
+ * every evaluation in a settling scene (20 blocks, each on the floor) solve all of their contact
+ * forces, ~2000 force evaluations per step. Rows and touches are sorted by island, in their order. */
+typedef struct island_set {
+    int *of;                  /* island of each body row, -1 for static bodies */
+    int *rows, *row_start;    /* rows of island k: rows[row_start[k] .. row_start[k + 1]) */
+    lc_touch *touches;        /* resting touches of island k: likewise, with touch_start */
+    int *touch_start;
+    int count;
+} island_set;
+
+static int island_root(int *parent, int x)
+{
+    while (parent[x] != x) {
+        parent[x] = parent[parent[x]];
+        x = parent[x];
+    }
+    return x;
+}
+
+static void island_join(int *parent, int a, int b)
+{
+    int ra = island_root(parent, a), rb = island_root(parent, b);
+    if (ra != rb) parent[ra < rb ? rb : ra] = ra < rb ? ra : rb;
+}
+
+static int build_islands(lc_world *w, const int *rows, int nrows, const lc_touch *rest, int nrest, island_set *is)
+{
+    int *v = lc_buf_get(&w->b_isl, ((size_t)w->count * 2 + (size_t)nrows * 4 + 3) * sizeof(int));
+    int *parent, *cursor, i, k;
+    is->touches = lc_buf_get(&w->b_isl_touch, (size_t)(nrest > 0 ? nrest : 1) * sizeof(lc_touch));
+    if (v == NULL || is->touches == NULL) return -1;
+    is->of = v;
+    parent = v + w->count;
+    is->rows = parent + w->count;
+    is->row_start = is->rows + nrows;
+    is->touch_start = is->row_start + nrows + 1;
+    cursor = is->touch_start + nrows + 1;
+    for (i = 0; i < w->count; ++i) {
+        parent[i] = i;
+        is->of[i] = -1;
+    }
+    for (i = 0; i < nrest; ++i)
+        if (!w->is_static[rest[i].a] && !w->is_static[rest[i].b]) island_join(parent, rest[i].a, rest[i].b);
+    for (i = 0; i < w->spring_count; ++i)
+        if (w->springs[i].def.body_b != LC_WORLD_ANCHOR) {
+            int a = lc_world_body_index(w, w->springs[i].def.body_a), b = lc_world_body_index(w, w->springs[i].def.body_b);
+            if (a >= 0 && b >= 0 && !w->is_static[a] && !w->is_static[b]) island_join(parent, a, b);
+        }
+    /* number the islands by their first row; is->of[root] holds the number while counting */
+    is->count = 0;
+    for (i = 0; i < nrows; ++i) {
+        int r = island_root(parent, rows[i]);
+        if (is->of[r] < 0) is->of[r] = is->count++;
+    }
+    for (i = 0; i < nrows; ++i) is->of[rows[i]] = is->of[island_root(parent, rows[i])];
+    for (k = 0; k <= is->count; ++k) is->row_start[k] = is->touch_start[k] = 0;
+    for (i = 0; i < nrows; ++i) is->row_start[is->of[rows[i]] + 1]++;
+    for (i = 0; i < nrest; ++i) is->touch_start[is->of[w->is_static[rest[i].a] ? rest[i].b : rest[i].a] + 1]++;
+    for (k = 0; k < is->count; ++k) {
+        is->row_start[k + 1] += is->row_start[k];
+        is->touch_start[k + 1] += is->touch_start[k];
+    }
+    for (k = 0; k < is->count; ++k) cursor[k] = is->row_start[k];
+    for (i = 0; i < nrows; ++i) is->rows[cursor[is->of[rows[i]]]++] = rows[i];
+    for (k = 0; k < is->count; ++k) cursor[k] = is->touch_start[k];
+    for (i = 0; i < nrest; ++i) is->touches[cursor[is->of[w->is_static[rest[i].a] ? rest[i].b : rest[i].a]]++] = rest[i];
+    return 0;
+}
+
+/* The rows and resting touches of the islands of bodies a and b (one island, or both side by side). */
+static int islands_of(lc_world *w, const island_set *is, int a, int b, const int **rows, int *nrows,
+                      lc_touch **touches, int *ntouches)
+{
+    int ia = is->of[a], ib = is->of[b], nr, nt;
+    int *r;
+    lc_touch *t;
+    if (ia < 0) ia = ib;
+    if (ib < 0) ib = ia;
+    if (ia < 0) {
+        *nrows = *ntouches = 0;
+        *rows = NULL;
+        *touches = NULL;
+        return 0;
+    }
+    if (ia == ib) {
+        *rows = is->rows + is->row_start[ia];
+        *nrows = is->row_start[ia + 1] - is->row_start[ia];
+        *touches = is->touches + is->touch_start[ia];
+        *ntouches = is->touch_start[ia + 1] - is->touch_start[ia];
+        return 0;
+    }
+    nr = is->row_start[ia + 1] - is->row_start[ia];
+    nt = is->touch_start[ia + 1] - is->touch_start[ia];
+    r = lc_buf_get(&w->b_isl_pick, (size_t)(nr + is->row_start[ib + 1] - is->row_start[ib]) * sizeof(int));
+    t = lc_buf_get(&w->b_isl_pick_touch,
+                   (size_t)(nt + is->touch_start[ib + 1] - is->touch_start[ib] + 1) * sizeof(lc_touch));
+    if (r == NULL || t == NULL) return -1;
+    memcpy(r, is->rows + is->row_start[ia], (size_t)nr * sizeof(int));
+    memcpy(r + nr, is->rows + is->row_start[ib], (size_t)(is->row_start[ib + 1] - is->row_start[ib]) * sizeof(int));
+    memcpy(t, is->touches + is->touch_start[ia], (size_t)nt * sizeof(lc_touch));
+    memcpy(t + nt, is->touches + is->touch_start[ib], (size_t)(is->touch_start[ib + 1] - is->touch_start[ib]) * sizeof(lc_touch));
+    *rows = r;
+    *nrows = nr + is->row_start[ib + 1] - is->row_start[ib];
+    *touches = t;
+    *ntouches = nt + is->touch_start[ib + 1] - is->touch_start[ib];
+    return 0;
+}
+
 /* Most crossings one step may set aside as stalled before it stops looking for crossings at all. */
 #define LC_MAX_STALLED 64
 
@@ -590,6 +701,7 @@ lc_status lc_world_step(lc_world *w, double dt)
     remaining = dt;
     while (remaining > 0.0) {
         int np, nc = 0, nkept = 0, best = -1, nimp, hits, *coupled = NULL, by_pair = 0;
+        island_set isl;
         double tmin = remaining;
         const int *pairs;
         lc_crossing *cross;
@@ -681,38 +793,34 @@ lc_status lc_world_step(lc_world *w, double dt)
         cross = (lc_crossing *)w->b_cross.p;
         w->cross_count = nc;
         /* earliest time of impact; a crossing whose gap is still open at the best time so far is later.
-         * The coupled world at that time is the same for every crossing, so it is integrated once per
-         * best time (in a pile each integration solves the whole pile's contact forces). */
+         * Each evaluation advances only the islands of the crossing's two bodies; those islands at
+         * the best time so far are kept for the next crossing of the same islands (a pile is one
+         * island, and each of its integrations solves the whole pile's contact forces). */
+        if (build_islands(w, rows, nrows, rest, nrest, &isl) != 0) goto oom;
         {
-            double *world_at_best = NULL, world_t = -1.0;
+            double *at_best = NULL, at_t = -1.0;
+            int at_ia = -2, at_ib = -2;
             for (i = 0; i < nc && !(best >= 0 && tmin == 0.0); ++i) {
                 double tau;
-                int pair[2], npair = 0;
-                const int *erows = rows;
-                int nerows = nrows;
-                if (!coupled[cross[i].a] && !coupled[cross[i].b]) {
-                    if (!w->is_static[cross[i].a]) pair[npair++] = cross[i].a;
-                    if (!w->is_static[cross[i].b]) pair[npair++] = cross[i].b;
-                    erows = pair;
-                    nerows = npair;
-                }
+                const int *erows;
+                int nerows, nerest;
+                lc_touch *erest;
+                if (islands_of(w, &isl, cross[i].a, cross[i].b, &erows, &nerows, &erest, &nerest) != 0) goto oom;
                 if (best >= 0) {
                     double g;
-                    const double *at = scratch;
-                    if (erows != rows) {
-                        if (lc_integrate(w, s0, tmin, erows, nerows, rest, nrest, scratch) != 0) goto oom;
-                    } else {
-                        if (world_at_best == NULL && (world_at_best = lc_buf_get(&w->b_sample0, bytes)) == NULL) goto oom;
-                        if (world_t != tmin) {
-                            if (lc_integrate(w, s0, tmin, rows, nrows, rest, nrest, world_at_best) != 0) goto oom;
-                            world_t = tmin;
-                        }
-                        at = world_at_best;
+                    int ia = isl.of[cross[i].a], ib = isl.of[cross[i].b];
+                    if (at_best == NULL && (at_best = lc_buf_get(&w->b_sample0, bytes)) == NULL) goto oom;
+                    if (at_t != tmin || at_ia != ia || at_ib != ib) {
+                        if (lc_integrate(w, s0, tmin, erows, nerows, erest, nerest, at_best) != 0) goto oom;
+                        at_t = tmin;
+                        at_ia = ia;
+                        at_ib = ib;
                     }
-                    g = lc_vertex_edge_gap(w, at, cross[i].a, cross[i].vertex, cross[i].b, cross[i].edge);
+                    g = lc_vertex_edge_gap(w, at_best, cross[i].a, cross[i].vertex, cross[i].b, cross[i].edge);
                     if (g > w->def.contact_gap) continue;
                 }
-                tau = lc_time_of_impact(w, s0, fmin(tmin, cross[i].t_hi), &cross[i], erows, nerows, rest, nrest, scratch);
+                tau = lc_time_of_impact(w, s0, fmin(tmin, cross[i].t_hi), &cross[i], erows, nerows, erest, nerest,
+                                        scratch);
                 if (tau < 0.0) continue;
                 if (best < 0 || tau < tmin) { tmin = tau; best = i; }
             }
@@ -733,7 +841,12 @@ lc_status lc_world_step(lc_world *w, double dt)
              * crossing test can see from here on: the pair met earlier, find when */
             if (lc_pair_separation(w, w->state, ba, bb) < -0.5 * w->def.contact_gap &&
                 lc_pair_separation(w, s0, ba, bb) > w->def.contact_gap) {
-                double t2 = lc_pair_time_of_impact(w, s0, tmin, ba, bb, rows, nrows, rest, nrest, scratch);
+                const int *erows;
+                int nerows, nerest;
+                lc_touch *erest;
+                double t2;
+                if (islands_of(w, &isl, ba, bb, &erows, &nerows, &erest, &nerest) != 0) goto oom;
+                t2 = lc_pair_time_of_impact(w, s0, tmin, ba, bb, erows, nerows, erest, nerest, scratch);
                 if (t2 < 0.0) goto oom;
                 tmin = t2;
                 by_pair = 1;
