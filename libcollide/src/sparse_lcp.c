@@ -49,13 +49,14 @@ static double dot(const double *x, const double *y, int m)
     return s;
 }
 
-/* Largest eigenvalue of A, from below (power iteration from the all-ones vector). */
+/* Largest eigenvalue of A, from below (power iteration). The start has unequal entries: the
+ * all-ones vector can lie in A's null space (two opposite rows on one pair of bodies). */
 static double norm_estimate(const lc_world *w, const lc_touch *t, int m, int tangent, int iterations, double *v,
                             double *av, double *body)
 {
     double lambda = 0.0, nv;
     int i, k;
-    for (i = 0; i < m; ++i) v[i] = 1.0;
+    for (i = 0; i < m; ++i) v[i] = 1.0 + 0.001 * (double)(((unsigned)i * 2654435761u) % 1000u);
     for (k = 0; k < iterations; ++k) {
         nv = sqrt(dot(v, v, m));
         if (!(nv > 0.0)) break;
@@ -142,6 +143,14 @@ int lc_sparse_lcp(lc_world *w, const lc_touch *t, int m, int tangent, const doub
         if (same && w->sparse_norm[tangent != 0] > lambda) lambda = w->sparse_norm[tangent != 0];
         w->sparse_norm[tangent != 0] = lambda;
         w->sparse_norm_rows[tangent != 0] = m;
+    }
+    if (!(lambda > 0.0) || !isfinite(lambda)) {
+        /* a row with a positive diagonal entry: A is not 0 after all, and its largest diagonal entry
+         * is a lower bound of ||A|| */
+        for (i = 0; i < m; ++i) {
+            double dii = lc_response_dir(w, &t[i], row_dir(&t[i], tangent), &t[i], row_dir(&t[i], tangent));
+            if (dii > lambda && isfinite(dii)) lambda = dii;
+        }
     }
     if (!(lambda > 0.0) || !isfinite(lambda)) {
         /* A = 0 (every row between static bodies): any x in bounds with y = b is the answer */
