@@ -190,7 +190,8 @@ int lc_sparse_lcp(lc_world *w, const lc_touch *t, int m, int tangent, const doub
             if (acg <= af) {
                 double gamma;
                 for (i = 0; i < m; ++i) {
-                    x[i] -= acg * p[i];
+                    /* within the feasible step: the clamp only takes off round-off past a bound */
+                    x[i] = clamp(x[i] - acg * p[i], lo[i], hi[i]);
                     g[i] -= acg * ap[i];
                 }
                 worst = gradients(x, g, lo, hi, m, alpha, phi, beta, &bb, &pp);
