@@ -41,6 +41,16 @@ static void body_box(const lc_world *w, const double *s, int row, box *b)
     out[0] = b->x0; out[1] = b->y0; out[2] = b->x1; out[3] = b->y1;
 }
 
+double lc_bounds_gap(const lc_world *w, const double *state, int a, int b)
+{
+    box ba, bb;
+    double g;
+    body_box(w, state, a, &ba);
+    body_box(w, state, b, &bb);
+    g = fmax(ba.x0 - bb.x1, bb.x0 - ba.x1);
+    return fmax(g, fmax(ba.y0 - bb.y1, bb.y0 - ba.y1));
+}
+
 static int overlap(const box *a, const box *b)
 {
     return a->x0 <= b->x1 && b->x0 <= a->x1 && a->y0 <= b->y1 && b->y0 <= a->y1;

@@ -156,6 +156,8 @@ int lc_collect_touches(const lc_world *w, const double *state, int a, int b, dou
         double r = w->shape[a].radius + w->shape[b].radius + max_gap;
         if (dx * dx + dy * dy > r * r) return count;
     }
+    /* nor bounding boxes (a block near a long wall, whose bounding circle reaches everything) */
+    if (lc_bounds_gap(w, state, a, b) > max_gap) return count;
     /* The contact normal of a pair comes from its separating axis: the face of either body along
      * which they are farthest apart (least overlap). At coincident corners of side-by-side boxes this
      * picks the shared vertical faces, never the collinear top or bottom faces. */

@@ -365,13 +365,14 @@ static int project_positions(lc_world *w)
 
 /* How far a vertex of one body can stray, in the other's frame, from the straight chord between its
  * positions at the ends of an interval of length h: turning by dtheta bends the path by r dtheta^2 / 8,
- * and a velocity change dv by dv h / 8. */
+ * and a change dv of the relative velocity by dv h / 8 (relative: two blocks falling side by side
+ * under gravity move on parallel parabolas, straight lines in each other's frame). */
 static double chord_deviation(const lc_world *w, const double *s0, const double *s1, double h, int a, int b)
 {
     double turn = fabs(s1[a * 6 + SA] - s0[a * 6 + SA]) + fabs(s1[b * 6 + SA] - s0[b * 6 + SA]);
-    double dva = hypot(s1[a * 6 + SVX] - s0[a * 6 + SVX], s1[a * 6 + SVY] - s0[a * 6 + SVY]);
-    double dvb = hypot(s1[b * 6 + SVX] - s0[b * 6 + SVX], s1[b * 6 + SVY] - s0[b * 6 + SVY]);
-    return turn * turn * (w->shape[a].radius + w->shape[b].radius) / 8.0 + (dva + dvb) * h / 8.0;
+    double dvx = (s1[a * 6 + SVX] - s0[a * 6 + SVX]) - (s1[b * 6 + SVX] - s0[b * 6 + SVX]);
+    double dvy = (s1[a * 6 + SVY] - s0[a * 6 + SVY]) - (s1[b * 6 + SVY] - s0[b * 6 + SVY]);
+    return turn * turn * (w->shape[a].radius + w->shape[b].radius) / 8.0 + hypot(dvx, dvy) * h / 8.0;
 }
 
 /* Distance between the bodies' bounding circles (negative when they overlap). */
@@ -416,6 +417,9 @@ static int swept_check(lc_world *w, const double *s0, const double *s1, double h
          * (the circles' distance is a lower bound of the bodies' distance, as the separation is) */
         if (circle_gap(w, s0, a, b) > dev + w->def.contact_distance &&
             circle_gap(w, s1, a, b) > dev + w->def.contact_distance)
+            continue;
+        if (lc_bounds_gap(w, s0, a, b) > dev + w->def.contact_distance &&
+            lc_bounds_gap(w, s1, a, b) > dev + w->def.contact_distance)
             continue;
         sep0 = lc_pair_separation(w, s0, a, b);
         /* touching at the start: resting contacts or impacts already guard the pair */
@@ -796,7 +800,7 @@ lc_status lc_world_step(lc_world *w, double dt)
          * Each evaluation advances only the islands of the crossing's two bodies; those islands at
          * the best time so far are kept for the next crossing of the same islands (a pile is one
          * island, and each of its integrations solves the whole pile's contact forces). */
-        if (build_islands(w, rows, nrows, rest, nrest, &isl) != 0) goto oom;
+        if (nc > 0 && build_islands(w, rows, nrows, rest, nrest, &isl) != 0) goto oom;
         {
             double *at_best = NULL, at_t = -1.0;
             int at_ia = -2, at_ib = -2;

@@ -165,6 +165,10 @@ double lc_vertex_edge_gap(const lc_world *w, const double *state, int a, int ver
 /* Candidate pairs (a < b by row, not both static) whose boxes, swept from s0 to s1 (s1 may equal s0) and
  * grown by margin, overlap. Writes pairs as int[2] into buf; returns count or -1. */
 int lc_broad_phase(lc_world *w, const double *s0, const double *s1, double margin, lc_buf *buf);
+/* Largest gap (m) between two bodies' axis-aligned bounding boxes along x or y at a state: a lower
+ * bound of their distance that, unlike the bounding circles, stays tight for a block over a long
+ * floor or beside a wall (boxes from the per-body cache). */
+double lc_bounds_gap(const lc_world *w, const double *state, int a, int b);
 /* The same, restricted to pairs with at least one of the nlist bodies in list (marked[row] != 0). */
 int lc_broad_phase_of(lc_world *w, const double *s0, const double *s1, double margin, const uint8_t *marked,
                       const int *list, int nlist, lc_buf *buf);
