@@ -23,6 +23,8 @@ counts are snapshot again and the recorder stops. Checked:
 * nothing lost: for each recorded topic, messages in the bag == messages the node published
   between the two snapshots; accepted commands (never rejected: all values are in range) ==
   command echoes published.
+The node's own /diagnostics counts (published/<topic>) are read at the same two pauses and written
+beside the wrapper's as ``published_diagnostics``, not judged (docs/hardening.md, "Counts for the node").
 Exit 0 when every check passed; the result is printed and written to OUT/result.json.
 """
 from __future__ import annotations
