@@ -101,20 +101,25 @@ static int warm_start(lc_world *w, lc_touch *t, int n)
  * Returns the resting count, -1 (no memory) or -2 (a point has passed deep into another body: the
  * step must fail). */
 static int gather_resting(lc_world *w, double *state, int *impacts, const uint8_t *marked, const int *list,
-                          int nlist)
+                          int nlist, int mid_step, int *started_deep)
 {
     int n, i, k = 0, urgent = 0;
     lc_touch *t;
     n = gather_touches_of(w, state, marked, list, nlist, &w->b_touch);
     t = (lc_touch *)w->b_touch.p;
     if (n < 0) return -1;
-    /* A point a quarter of the smaller body's size inside the other has passed through it: nothing
-     * legitimate gets there within a step (steps start apart; impacts stop points at the gap; resting
-     * drift is ~contact_gap), only speeds or spins far beyond what the step resolves (a 1e6 m sliver
-     * at 1e6 rad/s, found by the fuzzer). Contact forces on such a point pumped energy without bound
-     * (velocities of 1e183 m/s); the step fails instead. */
-    for (i = 0; i < n; ++i)
-        if (t[i].gap < -0.25 * fmin(w->shape[t[i].a].radius, w->shape[t[i].b].radius)) return -2;
+    /* Within a step (mid_step: not its first pass) that started without one, a point a quarter of
+     * the smaller body's size inside the other has passed through it: nothing legitimate gets there
+     * within a step (impacts stop points at the gap, resting drift is ~contact_gap), only speeds or
+     * spins far beyond what the step resolves (a 1e6 m sliver at 1e6 rad/s, found by the fuzzer).
+     * Contact forces on such a point pumped energy without bound (velocities of 1e183 m/s); the step
+     * fails instead. A step may start overlapping (bodies created or placed into each other, which
+     * the API allows): then *started_deep is set and the end-of-step projection separates them. */
+    for (i = 0; i < n && !*started_deep; ++i)
+        if (t[i].gap < -0.25 * fmin(w->shape[t[i].a].radius, w->shape[t[i].b].radius)) {
+            if (!mid_step) *started_deep = 1;   /* the projection's job, for this whole step */
+            else return -2;
+        }
     /* within the time-of-impact tolerance of the gap counts as at the gap, as it does for a crossing
      * (whose time of impact would be 0): all of them are resolved here in one group, not one pass each */
     for (i = 0; i < n; ++i)
@@ -675,7 +680,7 @@ lc_status lc_world_step(lc_world *w, double dt)
     size_t bytes;
     double *backup, *s0, *s1, *scratch, remaining, time0;
     int *rows, nrows = 0, i, events = 0, nstalled = 0, nrest = 0, passes = 0;
-    int *drows, ndirty = 0, local_next = 0, body_springs = 0;
+    int *drows, ndirty = 0, local_next = 0, body_springs = 0, started_deep = 0;
     uint8_t *dirty;
     double last_tmin = 0.0, trial_left = 0.0;
     lc_crossing stalled[LC_MAX_STALLED];
@@ -725,9 +730,9 @@ lc_status lc_world_step(lc_world *w, double dt)
         /* after an impact in free flight only the impact's bodies can have come to touch anything:
          * every other pair was apart (nothing rested) and moved without an impact */
         if (local_next && !body_springs)
-            nrest = gather_resting(w, w->state, &events, dirty, drows, ndirty);
+            nrest = gather_resting(w, w->state, &events, dirty, drows, ndirty, passes > 0, &started_deep);
         else
-            nrest = gather_resting(w, w->state, &events, NULL, NULL, 0);
+            nrest = gather_resting(w, w->state, &events, NULL, NULL, 0, passes > 0, &started_deep);
         if (nrest == -2)
             return step_failed(w, backup, time0, LC_ERR_NUMERIC,
                                "a body passed deep into another within the step (speeds or spins beyond what dt can resolve)");
