@@ -109,14 +109,16 @@ static int gather_resting(lc_world *w, double *state, int *impacts, const uint8_
     t = (lc_touch *)w->b_touch.p;
     if (n < 0) return -1;
     /* Within a step (mid_step: not its first pass) that started without one, a point a quarter of
-     * the smaller body's size inside the other has passed through it: nothing legitimate gets there
+     * the smaller body's size (and at least 100 contact_distances: a 1e-12 m polygon is not "deep" at
+     * 1e-12 m) inside the other has passed through it: nothing legitimate gets there
      * within a step (impacts stop points at the gap, resting drift is ~contact_gap), only speeds or
      * spins far beyond what the step resolves (a 1e6 m sliver at 1e6 rad/s, found by the fuzzer).
      * Contact forces on such a point pumped energy without bound (velocities of 1e183 m/s); the step
      * fails instead. A step may start overlapping (bodies created or placed into each other, which
      * the API allows): then *started_deep is set and the end-of-step projection separates them. */
     for (i = 0; i < n && !*started_deep; ++i)
-        if (t[i].gap < -0.25 * fmin(w->shape[t[i].a].radius, w->shape[t[i].b].radius)) {
+        if (t[i].gap < -fmax(0.25 * fmin(w->shape[t[i].a].radius, w->shape[t[i].b].radius),
+                             100.0 * w->def.contact_distance)) {
             if (!mid_step) *started_deep = 1;   /* the projection's job, for this whole step */
             else return -2;
         }
@@ -667,6 +669,38 @@ static int keep_clean_crossings(lc_world *w, const uint8_t *dirty, double tmin)
     return kept;
 }
 
+/* Contact forces do no work beyond round-off; a trial interval in which the bodies they act on gain
+ * more than their kinetic energy again (plus 1 J), gravity's work counted, has blown up: a point
+ * driven by forces of 1e23 N against an edge turning at 1e6 rad/s (fuzzer inputs), never a real
+ * scene. Bodies with thrust, torque or a spring can gain energy legitimately: then no verdict. */
+static int contact_energy_blew_up(const lc_world *w, const double *s0, const double *s1, const lc_touch *rest,
+                                  int nrest, uint8_t *mark)
+{
+    double ke0 = 0.0, gain = 0.0;
+    int i, verdict = 1;
+    for (i = 0; i < nrest; ++i) mark[rest[i].a] = mark[rest[i].b] = 1;
+    for (i = 0; i < w->spring_count && verdict; ++i) {
+        int a = lc_world_body_index(w, w->springs[i].def.body_a);
+        int b = w->springs[i].def.body_b == LC_WORLD_ANCHOR ? -1 : lc_world_body_index(w, w->springs[i].def.body_b);
+        if ((a >= 0 && mark[a]) || (b >= 0 && mark[b])) verdict = 0;
+    }
+    for (i = 0; i < w->count; ++i) {
+        const double *a = &s0[i * 6], *b = &s1[i * 6];
+        double m, in;
+        if (!mark[i]) continue;
+        mark[i] = 0;
+        if (w->is_static[i]) continue;
+        if (w->ext_force[i].x != 0.0 || w->ext_force[i].y != 0.0 || w->ext_torque[i] != 0.0) verdict = 0;
+        m = w->inv_mass[i] > 0.0 ? 1.0 / w->inv_mass[i] : 0.0;
+        in = w->inv_inertia[i] > 0.0 ? 1.0 / w->inv_inertia[i] : 0.0;
+        ke0 += 0.5 * m * (a[SVX] * a[SVX] + a[SVY] * a[SVY]) + 0.5 * in * a[SW] * a[SW];
+        gain += 0.5 * m * (b[SVX] * b[SVX] + b[SVY] * b[SVY] - a[SVX] * a[SVX] - a[SVY] * a[SVY]) +
+                0.5 * in * (b[SW] * b[SW] - a[SW] * a[SW]) -
+                m * (w->def.gravity.x * (b[SX] - a[SX]) + w->def.gravity.y * (b[SY] - a[SY]));
+    }
+    return verdict && !(gain <= ke0 + 1.0);
+}
+
 static lc_status step_failed(lc_world *w, const double *backup, double time0, lc_status s, const char *what)
 {
     memcpy(w->state, backup, (size_t)w->count * 6 * sizeof(double));
@@ -775,6 +809,14 @@ lc_status lc_world_step(lc_world *w, double dt)
                 if (!isfinite(s1[rows[i] * 6 + k]))
                     return step_failed(w, backup, time0, LC_ERR_NUMERIC,
                                        "integration produced a non-finite state (forces too stiff for dt?)");
+        }
+        if (nrest > 0) {
+            uint8_t *mark = lc_buf_get(&w->b_emark, (size_t)w->count);
+            if (mark == NULL) goto oom;
+            memset(mark, 0, (size_t)w->count);
+            if (contact_energy_blew_up(w, s0, s1, rest, nrest, mark))
+                return step_failed(w, backup, time0, LC_ERR_NUMERIC,
+                                   "contact forces gained energy (speeds or spins beyond what dt can resolve)");
         }
         if (keep_for_warm_start(w, rest, nrest) != 0) goto oom;
         tmin = trial;

@@ -100,6 +100,7 @@ struct lc_world {
     lc_buf b_sample0, b_sample1; /* step.c only: sub-interval states of the swept check */
     lc_buf b_swept;
     lc_buf b_rkeys;
+    lc_buf b_emark;          /* step.c only: bodies under resting contact, for the energy check */
     lc_buf b_isl, b_isl_touch, b_isl_pick, b_isl_pick_touch; /* step.c only: islands of a pass */
     lc_buf b_sparse, b_sparse_body; /* sparse_lcp.c: its vectors and the bodies' responses */
     double sparse_norm[2];   /* sparse_lcp.c: last ||A|| estimate of normal [0] and tangent [1] rows, */
