@@ -222,6 +222,9 @@ static int fz_overlaps_any(const lc_world *w, lc_body_id id, double *depth, lc_b
         if (v.ids[i] == id || (v.is_static[i] && v.is_static[ia])) continue;
         if (!fz_world_poly(w, v.ids[i], &b)) continue;
         s = fz_separation(&a, &b);
+        /* -inf: one polygon has no edge left in doubles (a 1e-12 m polygon flung past 1e4 m, where
+         * its vertices round to one point); its overlap is not measurable, not infinite */
+        if (!isfinite(s)) continue;
         if (s < -fz_tol(&a, &b)) {
             if (depth) *depth = -s;
             if (other) *other = v.ids[i];
