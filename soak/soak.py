@@ -4,13 +4,14 @@
     nice python soak/soak.py --duration 3600 --out /tmp/soak1h      # the documented one-hour run
     nice python soak/soak.py --duration 90                          # what tests/python/test_soak.py runs
 
-The node (soak/counted_node.py: the unmodified SimNode plus a publish() counter per topic) runs at
-real_time_factor 0 with 4 blocks, starting paused. The project's recorder
-(``python -m collide_ros.recorder``) records the state, /tf, /clock and command-echo topics. Once
-the recorder is subscribed to every one of them the counts are snapshot and the sim resumes; a
-driver then sends, at random, thrust (WrenchStamped), thruster, cmd_vel, spring and parameter
-commands, and calls ~/reset periodically. At the end the sim is paused, the recorder drains, the
-counts are snapshot again and the recorder stops. Checked:
+The node (``python -m collide_ros.node``, unmodified) runs at real_time_factor 0 with 4 blocks,
+starting paused. The project's recorder (``python -m collide_ros.recorder``) records the state,
+/tf, /clock and command-echo topics. Once the node's writers have matched the recorder's readers on
+every one of them (``subscribers/<topic>`` in /diagnostics), the node's message counts are read
+from /diagnostics (``published/<topic>``, docs/ros_interface.md) and the sim resumes; a driver
+then sends, at random, thrust (WrenchStamped), thruster, cmd_vel, spring and parameter commands,
+and calls ~/reset periodically. At the end the sim is paused, the recorder drains, the counts are
+read again once they have settled, and the recorder stops. Checked:
 
 * no NaN: every bodies/states message in the bag is finite;
 * no tunnelling: every dynamic body's centre in every recorded message is inside the walls' inner
@@ -21,10 +22,8 @@ counts are snapshot again and the recorder stops. Checked:
 * memory flat: the node's RSS (VmRSS) after the warm-up (first ``--warmup`` fraction of the run,
   default 25 %) grows by at most ``--rss-bound-mb`` (default 8 MiB);
 * nothing lost: for each recorded topic, messages in the bag == messages the node published
-  between the two snapshots; accepted commands (never rejected: all values are in range) ==
-  command echoes published.
-The node's own /diagnostics counts (published/<topic>) are read at the same two pauses and written
-beside the wrapper's as ``published_diagnostics``, not judged (docs/hardening.md, "Counts for the node").
+  between the two snapshots; for each command topic, commands sent == commands the node took
+  (``received/<topic>``) == accepted (never rejected: all values are in range) == echoes published.
 Exit 0 when every check passed; the result is printed and written to OUT/result.json.
 """
 from __future__ import annotations
@@ -65,11 +64,10 @@ class SoakResult:
     commands_sent: dict[str, int] = field(default_factory=dict)
     resets: int = 0
     param_sets: int = 0
-    published: dict[str, int] = field(default_factory=dict)
+    published: dict[str, int] = field(default_factory=dict)  # recorded topic -> published (node's count)
     recorded: dict[str, int] = field(default_factory=dict)
-    # the same counts from the node's own /diagnostics (published/<topic>), read at the same two
-    # pauses: recorded beside the wrapper's to find where they differ (docs/hardening.md), not judged
-    published_diagnostics: dict[str, int] = field(default_factory=dict)
+    received: dict[str, int] = field(default_factory=dict)   # command topic -> taken by the node
+    accepted: dict[str, int] = field(default_factory=dict)   # command topic -> accepted by the node
     states_checked: int = 0
     max_abs_centre: float = 0.0
     non_finite: int = 0
@@ -212,18 +210,25 @@ def _wait_recorder_subscribed(client: Any, topics: list[str], timeout: float) ->
     return missing
 
 
-def _snapshot(proc: subprocess.Popen[bytes], path: Path, seq: int, timeout: float = 10.0) -> dict[str, int]:
-    proc.send_signal(signal.SIGUSR1)
+def _wait_matched(client: Any, topics: list[str], timeout: float) -> list[str]:
+    """Topics whose writer in the node has not matched every subscription the graph shows after
+    ``timeout`` s (the node's ``subscribers/<topic>``). The graph lists a subscription before the
+    writer has matched it, and what is published before the match does not reach the recorder."""
     end = time.monotonic() + timeout
-    while time.monotonic() < end:
-        try:
-            data = json.loads(path.read_text())
-            if data["seq"] >= seq:
-                return {k: int(v) for k, v in data["counts"].items()}
-        except (OSError, ValueError, KeyError):
-            pass
-        time.sleep(0.05)
-    raise RuntimeError("soak: the node wrote no publish counts")
+    missing = list(topics)
+    while time.monotonic() < end and missing:
+        vals = client.diagnostics(timeout=max(0.1, end - time.monotonic())) or {}
+        missing = [t for t in topics
+                   if int(vals.get(f"subscribers/{t.lstrip('/')}", "0"))
+                   < len(client.node.get_subscriptions_info_by_topic(t))]
+    return missing
+
+
+def _counts(client: Any, when: str) -> dict[str, int]:
+    counts = client.settled_counts(timeout=30.0)
+    if counts is None:
+        raise RuntimeError(f"soak: the node's /diagnostics counts did not settle {when}")
+    return counts
 
 
 def run_soak(duration: float, out: Path, seed: int = 1, state_rate: float = 10.0, command_hz: float = 40.0,
@@ -238,12 +243,10 @@ def run_soak(duration: float, out: Path, seed: int = 1, state_rate: float = 10.0
     out.mkdir(parents=True, exist_ok=True)
     env = _env()
     res = SoakResult(rss_bound_mib=rss_bound_mib)
-    counts_file = out / "published.json"
     node_log = open(out / "node.log", "wb")
     rec_log = open(out / "recorder.log", "wb")
     bag = out / "bag"
-    node = subprocess.Popen([sys.executable, str(REPO / "soak" / "counted_node.py"), str(counts_file),
-                             "--ros-args", *NODE_ARGS, "-p", f"state_rate:={state_rate}",
+    node = subprocess.Popen([sys.executable, "-m", "collide_ros.node", "--ros-args", *NODE_ARGS, "-p", f"state_rate:={state_rate}",
                              "-p", f"tf_rate:={state_rate}", "-p", f"clock_rate:={state_rate}"],
                             stdout=node_log, stderr=subprocess.STDOUT, env=env, preexec_fn=_die_with_parent)
     rec: subprocess.Popen[bytes] | None = None
@@ -275,9 +278,10 @@ def run_soak(duration: float, out: Path, seed: int = 1, state_rate: float = 10.0
                        "Twist": Twist}.get(typ or "", WrenchStamped)
                 if not client.wait_subscribed(topic, cls, 30.0):
                     raise RuntimeError(f"soak: node not subscribed to {topic}")
-        client.spin(1.0)  # the node's writers match the recorder's readers (discovery both ways)
-        before = _snapshot(node, counts_file, 1)
-        before_diag = client.settled_counts(timeout=30.0) or {}
+        unmatched = _wait_matched(client, recorded_topics(), 60.0)
+        if unmatched:
+            raise RuntimeError(f"soak: the node's writers did not match the recorder on {unmatched}")
+        before = _counts(client, "before the run")
         if client.call(SetBool, "pause", SetBool.Request(data=False)) is None:
             raise RuntimeError("soak: ~/pause failed")
         t_start = time.monotonic()
@@ -333,16 +337,18 @@ def run_soak(duration: float, out: Path, seed: int = 1, state_rate: float = 10.0
             raise RuntimeError("soak: ~/pause failed at the end")
         res.duration_s = time.monotonic() - t_start
         client.spin(3.0)  # the recorder drains what is in flight
-        after = _snapshot(node, counts_file, 2)
-        after_diag = client.settled_counts(timeout=30.0) or {}
+        after = _counts(client, "after the run")
         last = client.fresh("bodies/states", timeout=0.1) or client.last.get("bodies/states")
         if last is not None and sim_t0 is not None:
             res.sim_time_s = last.header.stamp.sec + 1e-9 * last.header.stamp.nanosec - sim_t0
         rec.send_signal(signal.SIGINT)
         rec.wait(60)
-        res.published = {t: after.get(t, 0) - before.get(t, 0) for t in recorded_topics()}
-        res.published_diagnostics = {t: after_diag.get(f"published/{t.lstrip('/')}", 0)
-                                     - before_diag.get(f"published/{t.lstrip('/')}", 0) for t in recorded_topics()}
+        def delta(key: str) -> int:
+            return after.get(key, 0) - before.get(key, 0)
+        res.published = {t: delta(f"published/{t.lstrip('/')}") for t in recorded_topics()}
+        cmd_topics = [t[len("/applied/"):] for t in recorded_topics() if t.startswith("/applied/")]
+        res.received = {t: delta(f"received/{t}") for t in cmd_topics}
+        res.accepted = {t: delta(f"accepted/{t}") for t in cmd_topics}
         res.commands_sent = dict(drv.sent)
         check_bag(bag, res)
         res.rss_growth_mib = (max(rss_after_warm) - rss_after_warm[0]) if len(rss_after_warm) > 1 else 0.0
@@ -384,8 +390,12 @@ def run_soak(duration: float, out: Path, seed: int = 1, state_rate: float = 10.0
         p, r = res.published.get(t, 0), res.recorded.get(t, 0)
         if p != r:
             res.failures.append(f"{t}: published {p}, recorded {r}")
-        if t.startswith("/applied/") and p != res.commands_sent.get(t, 0):
-            res.failures.append(f"{t}: sent {res.commands_sent.get(t, 0)} commands, {p} echoed")
+        if t.startswith("/applied/"):
+            c = t[len("/applied/"):]
+            sent = res.commands_sent.get(t, 0)
+            if not sent == res.received.get(c) == res.accepted.get(c) == p:
+                res.failures.append(f"{c}: sent {sent}, taken {res.received.get(c)}, "
+                                    f"accepted {res.accepted.get(c)}, echoed {p}")
     if res.sim_time_s > 0 and res.duration_s > 0:
         res.steps_per_wall_s = res.sim_time_s / 0.001 / res.duration_s
     (out / "result.json").write_text(json.dumps({**asdict(res), "ok": res.ok}, indent=1))

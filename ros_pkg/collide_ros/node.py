@@ -992,9 +992,13 @@ class SimNode(Node):
         self._window_steps = 0
 
     def _count_values(self) -> dict[str, str]:
-        """published/<topic> for every publisher (published/diagnostics: the ones before this message),
-        then received/, accepted/, rejected/, lost/<topic> for every command topic (docs/ros_interface.md)."""
+        """published/<topic> and subscribers/<topic> for every publisher (published/diagnostics: the
+        ones before this message), then received/, accepted/, rejected/, lost/<topic> for every command topic (docs/ros_interface.md)."""
         vals = {f"published/{k}": str(p.count) for k, p in sorted(self._published.items())}
+        # the writer's matched readers, not the graph's subscriptions: a subscription the graph
+        # already shows may not be matched yet, and gets nothing published before it is
+        vals.update({f"subscribers/{k}": str(p.pub.get_subscription_count())
+                     for k, p in sorted(self._published.items())})
         for topic, c in sorted(self._commands.items()):
             vals[f"received/{topic}"] = str(c.received)
             vals[f"accepted/{topic}"] = str(c.accepted)

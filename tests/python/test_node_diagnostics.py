@@ -114,13 +114,34 @@ def _pause(sim: SimClient, on: bool) -> None:
     assert r is not None and r.success
 
 
+def _ours(sim: SimClient) -> dict[str, int]:
+    """This client's subscriptions on every topic of PUBLISHED, as the ROS graph lists them."""
+    return {t: sum(i.node_name == sim.node.get_name()
+                   for i in sim.node.get_subscriptions_info_by_topic(t if t.startswith("/") else f"/{t}"))
+            for t in PUBLISHED}
+
+
+def _matched(sim: SimClient, ours: dict[str, int]) -> bool:
+    """The graph lists ``ours`` of this client's subscriptions per topic, and the node's
+    subscribers/<topic> (readers its writer has matched) equals all the graph lists."""
+    vals = sim.diagnostics()
+    assert vals is not None
+    for t in PUBLISHED:
+        infos = sim.node.get_subscriptions_info_by_topic(t if t.startswith("/") else f"/{t}")
+        if sum(i.node_name == sim.node.get_name() for i in infos) != ours[t]:
+            return False
+        if int(vals[f"subscribers/{t.lstrip('/')}"]) != len(infos):
+            return False
+    return True
+
+
 def test_counts_match_what_a_subscriber_received(sim: SimClient) -> None:
+    base = _ours(sim)
     counter = Counter(sim)
     try:
-        for topic in PUBLISHED:  # every one of our readers matched before the first snapshot
-            full = topic if topic.startswith("/") else f"/{topic}"
-            assert sim.wait_for(lambda: any(i.node_name == sim.node.get_name()
-                                            for i in sim.node.get_subscriptions_info_by_topic(full)), 10.0)
+        # every one of our readers matched by the node's writer before the first snapshot: its
+        # subscribers/<topic> counts each of them (the graph lists a reader before it is matched)
+        assert sim.wait_for(lambda: _matched(sim, {t: n + 1 for t, n in base.items()}), 20.0)
         _pause(sim, True)
         before = sim.settled_counts()
         assert before is not None
@@ -151,6 +172,8 @@ def test_counts_match_what_a_subscriber_received(sim: SimClient) -> None:
     finally:
         counter.close()
         _pause(sim, False)
+    # and unmatched again once our readers are gone
+    assert sim.wait_for(lambda: _matched(sim, base), 20.0)
 
 
 def test_commands_dropped_while_the_executor_is_busy_are_counted_lost(sim: SimClient) -> None:
