@@ -66,7 +66,24 @@ class Bench:
         self.out: dict[str, Any] = {}
 
     def run(self, tasks: list[Task], repeats: int | None = None) -> dict[str, dict[str, Any]]:
-        return harness.run_interleaved(self.pool, tasks, self.repeats if repeats is None else repeats, log)
+        res = harness.run_interleaved(self.pool, tasks, self.repeats if repeats is None else repeats, log)
+        self.time_stages(tasks, res)
+        return res
+
+    def time_stages(self, tasks: list[Task], res: dict[str, dict[str, Any]]) -> None:
+        """One more run of every finished libcollide task with stage timing on, for the per-stage
+        shares of its time (`stage_times`: s per step). Separate from the timed repeats: the clock
+        reads cost ~5-15 % of a small scene's step."""
+        for t in tasks:
+            r = res.get(t.key)
+            if t.engine != "libcollide" or r is None or r.get("status") != "ok" or "stage_times" in r:
+                continue
+            timed = self.pool.run(Task(t.engine, t.scene, t.dt, {**t.settings, "stage_timing": True}, t.sample_dt,
+                                       t.budget, t.label, t.key))
+            st = timed.get("stages") or {}
+            steps = max(int(st.get("steps", 0)), 1)
+            if timed.get("status") == "ok" and st.get("time_step"):
+                r["stage_times"] = {k: st[k] / steps for k in st if k.startswith("time_")}
 
     # ---- (1) seed scene: work-precision --------------------------------------------------------
     def wp(self) -> None:
@@ -103,7 +120,8 @@ class Bench:
                              "escaped": int(sum(x["escaped"] for x in ok)),
                              "cost": float(np.median([x["cpu_per_sim_s"] for x in runs if "cpu_per_sim_s" in x])),
                              "us_per_step": float(np.median([x["us_per_step"] for x in runs if "us_per_step" in x])),
-                             "stages": runs[0].get("stages", {})})
+                             "stages": runs[0].get("stages", {}),
+                             "stage_times": runs[0].get("stage_times", {})})
             out[f"g{g:g}"] = rows
         # N = 6 at dt 1/60, g = 0 and 9.8 (the seed page's block count)
         tasks = [Task(eng, scenes.seed(6, g, sd), 1 / 60, {}, None, self.budget) for g in gs for sd in seeds

@@ -22,6 +22,10 @@ STAGES = [("force_evaluations", "ODE integrator (force evaluations)"),
           ("serial_iterations", "serial impact passes"),
           ("inelastic_fallbacks", "inelastic fallback"),
           ("contact_solves", "resting-contact LCP")]
+# libcollide's disjoint timed stages (lc_counters time_*), in the order of a pass
+TIME_STAGES = [("time_detection", "detection"), ("time_integration", "integration"),
+               ("time_toi_search", "time-of-impact search"), ("time_impulses", "impulses"),
+               ("time_projection", "projection")]
 
 
 def f(x: Any, fmt: str = ".3g") -> str:
@@ -472,30 +476,51 @@ def write(out: dict[str, Any], path: str, img_dir: str) -> None:
         L += [""]
 
     # model only what a scene needs
-    rows: list[tuple[str, dict[str, Any]]] = []
+    rows: list[tuple[str, dict[str, Any], dict[str, float]]] = []
     for sec in ("impacts", "cradle", "tunnel", "stacks", "pyramid", "scaling"):
         for r in out.get(sec) or []:
             if r["engine"] == "libcollide" and r["label"] == "libcollide" and r.get("stages"):
-                rows.append((f"{r['scene']} (1/{round(1 / r['dt'])})", r["stages"]))
+                rows.append((f"{r['scene']} (1/{round(1 / r['dt'])})", r["stages"], r.get("stage_times") or {}))
     if wp:
         for g in ("g0", "g9.8"):
             r = next((r for r in wp.get(g, []) if r["label"] == "libcollide"), None)
             if r and r.get("stages"):
-                rows.append((f"seed 20, {g}", r["stages"]))
+                rows.append((f"seed 20, {g}", r["stages"], r.get("stage_times") or {}))
     if rows:
         L += ["## Model only what a scene needs: libcollide's pipeline per scene", "",
               "Which stages ran (counts per step, from `world.counters(last=False)` of the first repeat); an "
-              "empty cell means the stage never ran in that scene. libcollide exposes counts, not per-stage "
-              "times, so time shares are not given.", "",
+              "empty cell means the stage never ran in that scene.", "",
               "| scene | " + " | ".join(name for _, name in STAGES) + " |", "|---|" + "---|" * len(STAGES)]
         seen = set()
-        for name, st in rows:
+        for name, st, _ in rows:
             if name in seen:
                 continue
             seen.add(name)
             steps = max(st.get("steps", 1), 1)
             L.append(f"| {name} | " + " | ".join(f"{st[k] / steps:.3g}" if st.get(k) else "" for k, _ in STAGES) + " |")
         L += [""]
+        timed = [(name, tm) for name, _, tm in rows if tm.get("time_step")]
+        if timed:
+            L += ["### Share of the step time per stage", "",
+                  "From one more run of each scene with `world.set_stage_timing(True)` (wall time per stage, "
+                  "`time_*` counters; not the timed repeats above, since the clock reads cost ~5-15 % of a "
+                  "small scene's step). The first five stages do not overlap; *other* is the rest of the step "
+                  "(bookkeeping between stages). Contact forces are solved inside the integrations (trial "
+                  "intervals, time-of-impact searches, swept checks), so their share is part of those columns.", "",
+                  "| scene | µs per step (timed run) | " + " | ".join(n for _, n in TIME_STAGES) +
+                  " | other | contact forces (inside) |", "|---|---|" + "---|" * (len(TIME_STAGES) + 2)]
+            seen = set()
+            for name, tm in timed:
+                if name in seen:
+                    continue
+                seen.add(name)
+                total = tm["time_step"]
+                parts = [tm.get(k, 0.0) / total for k, _ in TIME_STAGES]
+                cells = [f"{100 * p:.0f} %" if p > 0 else "" for p in parts]
+                other = max(0.0, 1.0 - sum(parts))
+                L.append(f"| {name} | {1e6 * total:.3g} | " + " | ".join(cells) +
+                         f" | {100 * other:.0f} % | {100 * tm.get('time_contact_forces', 0.0) / total:.0f} % |")
+            L += [""]
 
     # costliest scenes: where libcollide's time goes (counters per step)
     costly = []
@@ -512,7 +537,13 @@ def write(out: dict[str, Any], path: str, img_dir: str) -> None:
             per = ", ".join(f"{k} {st[k] / steps:.3g}" for k in ("force_evaluations", "analytic_advances",
                             "toi_searches", "toi_iterations", "collisions", "serial_iterations", "inelastic_fallbacks",
                             "contact_solves", "contact_solve_iterations", "resting_contacts") if st.get(k))
-            L.append(f"- **{r['scene']}**: {r['us_per_step']:.4g} µs per 1/60 s step{status_cell(r)}; per step: {per}.")
+            tm = r.get("stage_times") or {}
+            share = ""
+            if tm.get("time_step"):
+                share = "; time: " + ", ".join(f"{n} {100 * tm.get(k, 0.0) / tm['time_step']:.0f} %"
+                                               for k, n in TIME_STAGES + [("time_contact_forces", "contact forces")]
+                                               if tm.get(k))
+            L.append(f"- **{r['scene']}**: {r['us_per_step']:.4g} µs per 1/60 s step{status_cell(r)}; per step: {per}{share}.")
         sc_rows = sorted([r for r in out.get("scaling") or [] if r["engine"] == "libcollide" and r.get("stages")],
                          key=lambda r: r["n"])
         if len(sc_rows) >= 2:
@@ -542,7 +573,6 @@ def write(out: dict[str, Any], path: str, img_dir: str) -> None:
           "- Rapier2D (optional in issue 4; needs a Rust driver) and native Box2D v3 with SIMD: not run here; "
           "their figures are in `../shared/notes/peer_bench.md`.",
           "- The 60 s hard-case stability suite belongs to the test suite, not to this benchmark.",
-          "- Per-stage time shares: libcollide has counters but no timers.",
           "- libcollide crashes and hangs found by this benchmark have minimal reproductions in `bench/repro/`.", ""]
     with open(path, "w") as fh:
         fh.write("\n".join(L))

@@ -1,5 +1,7 @@
 """libcollide through its cffi binding. Settings: any lc_world_def field (e.g. toi_time_tolerance,
-toi_distance_tolerance, impact_mode, integrator); damping is 0. Steps call the C function directly."""
+toi_distance_tolerance, impact_mode, integrator), and ``stage_timing`` (bool: fill the counters' time_*
+fields, for the per-stage time shares; off in timed runs); damping is 0. Steps call the C function
+directly."""
 from __future__ import annotations
 
 from typing import Any
@@ -17,7 +19,10 @@ class LibCollide(Engine):
         import collide
         from collide._ffi import lib
         self._lib = lib
+        settings = dict(settings)
+        timing = bool(settings.pop("stage_timing", False))
         self.world = collide.World(gravity=(0.0, -scene.gravity), damping=0.0, **settings)
+        self.world.set_stage_timing(timing)
         rows = []
         for k, b in enumerate(scene.boxes):
             body = self.world.add_box(b.w, b.h, position=(b.x, b.y), angle=b.angle, velocity=(b.vx, b.vy),

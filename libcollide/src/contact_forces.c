@@ -203,7 +203,7 @@ static int solve_large_group(lc_world *w, const double *state, lc_touch *sub, in
     return products;
 }
 
-int lc_contact_forces(lc_world *w, const double *state, lc_touch *touches, int n, double *acc)
+static int contact_forces(lc_world *w, const double *state, lc_touch *touches, int n, double *acc)
 {
     int *parent, *order, *group, *start;
     int i, g0, rows = w->count;
@@ -309,4 +309,12 @@ int lc_contact_forces(lc_world *w, const double *state, lc_touch *touches, int n
         g0 = g1;
     }
     return 0;
+}
+
+int lc_contact_forces(lc_world *w, const double *state, lc_touch *touches, int n, double *acc)
+{
+    double t0 = lc_stage_begin(w);
+    int r = contact_forces(w, state, touches, n, acc);
+    lc_stage_end(w, &w->last.time_contact_forces, t0);
+    return r;
 }

@@ -292,6 +292,13 @@ static void add_counters(lc_counters *total, const lc_counters *last)
     total->impulse_solves += last->impulse_solves;
     total->position_projections += last->position_projections;
     if (last->max_lcp_residual > total->max_lcp_residual) total->max_lcp_residual = last->max_lcp_residual;
+    total->time_step += last->time_step;
+    total->time_detection += last->time_detection;
+    total->time_integration += last->time_integration;
+    total->time_toi_search += last->time_toi_search;
+    total->time_impulses += last->time_impulses;
+    total->time_projection += last->time_projection;
+    total->time_contact_forces += last->time_contact_forces;
 }
 
 /* Post-stabilisation: when a point ends the step closer than half the contact gap (or inside another
@@ -719,6 +726,7 @@ static int contact_energy_blew_up(const lc_world *w, const double *s0, const dou
 
 static lc_status step_failed(lc_world *w, const double *backup, double time0, lc_status s, const char *what)
 {
+    lc_stage_end(w, &w->last.time_step, w->step_t0);
     memcpy(w->state, backup, (size_t)w->count * 6 * sizeof(double));
     w->time = time0;
     w->contact_count = 0;
@@ -732,12 +740,13 @@ lc_status lc_world_step(lc_world *w, double dt)
     int *rows, nrows = 0, i, events = 0, nstalled = 0, nrest = 0, passes = 0;
     int *drows, ndirty = 0, local_next = 0, body_springs = 0, started_deep = 0;
     uint8_t *dirty;
-    double last_tmin = 0.0, trial_left = 0.0;
+    double last_tmin = 0.0, trial_left = 0.0, ts;
     lc_crossing stalled[LC_MAX_STALLED];
     if (w == NULL) return LC_ERR_NULL;
     if (!isfinite(dt)) return lc_fail(w, LC_ERR_NOT_FINITE, "dt is not finite (%g)", dt);
     if (!(dt > 0.0) || dt > 1.0) return lc_fail(w, LC_ERR_OUT_OF_RANGE, "dt = %g is outside (0, 1] s", dt);
     memset(&w->last, 0, sizeof w->last);
+    w->step_t0 = lc_stage_begin(w);
     w->last.steps = 1;
     w->step_dt = dt;
     w->contact_count = 0;
@@ -752,6 +761,7 @@ lc_status lc_world_step(lc_world *w, double dt)
     if (w->count == 0) {
         /* nothing to move: time still passes */
         w->time += dt;
+        lc_stage_end(w, &w->last.time_step, w->step_t0);
         add_counters(&w->total, &w->last);
         w->error[0] = '\0';
         return LC_OK;
@@ -779,10 +789,12 @@ lc_status lc_world_step(lc_world *w, double dt)
         int events_before = events, local = 0, can_reuse;
         /* after an impact in free flight only the impact's bodies can have come to touch anything:
          * every other pair was apart (nothing rested) and moved without an impact */
+        ts = lc_stage_begin(w);
         if (local_next && !body_springs)
             nrest = gather_resting(w, w->state, &events, dirty, drows, ndirty, passes > 0, &started_deep);
         else
             nrest = gather_resting(w, w->state, &events, NULL, NULL, 0, passes > 0, &started_deep);
+        lc_stage_end(w, &w->last.time_detection, ts);
         if (nrest == -2)
             return step_failed(w, backup, time0, LC_ERR_NUMERIC,
                                "a body passed deep into another within the step (speeds or spins beyond what dt can resolve)");
@@ -813,12 +825,14 @@ lc_status lc_world_step(lc_world *w, double dt)
          * valid. Then only the impact's bodies are re-advanced, to that same end, and only their pairs
          * are tested again, instead of the whole world. */
         local = can_reuse && nrest == 0 && events == events_before && !body_springs;
+        ts = lc_stage_begin(w);
         if (local) {
             if (lc_integrate(w, s0, trial, drows, ndirty, rest, 0, scratch) != 0) goto oom;
             for (i = 0; i < ndirty; ++i) memcpy(&s1[drows[i] * 6], &scratch[drows[i] * 6], 6 * sizeof(double));
         } else {
             if (lc_integrate(w, s0, trial, rows, nrows, rest, nrest, s1) != 0) goto oom;
         }
+        lc_stage_end(w, &w->last.time_integration, ts);
         for (i = 0; i < nrows; ++i) {
             int k;
             for (k = 0; k < 6; ++k)
@@ -838,6 +852,7 @@ lc_status lc_world_step(lc_world *w, double dt)
         tmin = trial;
 
         /* vertices that entered another body during the trial step */
+        ts = lc_stage_begin(w);
         if (local) {
             nc = nkept = keep_clean_crossings(w, dirty, last_tmin);
             np = lc_broad_phase_of(w, s0, s1, w->def.contact_distance, dirty, drows, ndirty, &w->b_pairs);
@@ -869,6 +884,7 @@ lc_status lc_world_step(lc_world *w, double dt)
         }
         for (i = nkept; i < nc; ++i) ((lc_crossing *)w->b_cross.p)[i].t_hi = trial;
         nc = swept_check(w, s0, s1, trial, pairs, np, nc, coupled, rows, nrows, rest, nrest);
+        lc_stage_end(w, &w->last.time_detection, ts);
         if (nc < 0) goto oom;
         cross = (lc_crossing *)w->b_cross.p;
         w->cross_count = nc;
@@ -876,6 +892,7 @@ lc_status lc_world_step(lc_world *w, double dt)
          * Each evaluation advances only the islands of the crossing's two bodies; those islands at
          * the best time so far are kept for the next crossing of the same islands (a pile is one
          * island, and each of its integrations solves the whole pile's contact forces). */
+        ts = lc_stage_begin(w);
         if (nc > 0 && build_islands(w, rows, nrows, rest, nrest, &isl) != 0) goto oom;
         {
             double *at_best = NULL, at_t = -1.0;
@@ -905,6 +922,7 @@ lc_status lc_world_step(lc_world *w, double dt)
                 if (best < 0 || tau < tmin) { tmin = tau; best = i; }
             }
         }
+        lc_stage_end(w, &w->last.time_toi_search, ts);
         if (best < 0) {
             local_next = 0;
             memcpy(w->state, s1, (size_t)w->count * 6 * sizeof(double));
@@ -914,6 +932,7 @@ lc_status lc_world_step(lc_world *w, double dt)
             continue;
         }
 
+        ts = lc_stage_begin(w);
         if (tmin > 0.0) {
             int ba = cross[best].a, bb = cross[best].b;
             if (lc_integrate(w, s0, tmin, rows, nrows, rest, nrest, w->state) != 0) goto oom;
@@ -926,7 +945,11 @@ lc_status lc_world_step(lc_world *w, double dt)
                 lc_touch *erest;
                 double t2;
                 if (islands_of(w, &isl, ba, bb, &erows, &nerows, &erest, &nerest) != 0) goto oom;
+                lc_stage_end(w, &w->last.time_integration, ts);
+                ts = lc_stage_begin(w);
                 t2 = lc_pair_time_of_impact(w, s0, tmin, ba, bb, erows, nerows, erest, nerest, scratch);
+                lc_stage_end(w, &w->last.time_toi_search, ts);
+                ts = lc_stage_begin(w);
                 if (t2 < 0.0) goto oom;
                 tmin = t2;
                 by_pair = 1;
@@ -935,10 +958,12 @@ lc_status lc_world_step(lc_world *w, double dt)
         } else {
             memcpy(w->state, s0, (size_t)w->count * 6 * sizeof(double));
         }
+        lc_stage_end(w, &w->last.time_integration, ts);
         remaining -= tmin;
         w->time = time0 + (dt - remaining);
         if (remaining < 1e-14 * dt) remaining = 0.0;
 
+        ts = lc_stage_begin(w);
         nimp = gather_impact(w, w->state, &cross[best], by_pair);
         if (nimp < 0) goto oom;
         /* past max_events_per_step (an impact storm: extreme speeds in a small box, a jam at e > 0)
@@ -953,6 +978,7 @@ lc_status lc_world_step(lc_world *w, double dt)
                     if (push_contact(w, &t[i], LC_CONTACT_COLLISION) != 0) goto oom;
                 }
         }
+        lc_stage_end(w, &w->last.time_impulses, ts);
         w->last.collisions++;
         events++;
         {
@@ -978,7 +1004,10 @@ lc_status lc_world_step(lc_world *w, double dt)
     }
     if (remaining == 0.0) w->time = time0 + dt;
     {
-        int pr = project_positions(w);
+        int pr;
+        ts = lc_stage_begin(w);
+        pr = project_positions(w);
+        lc_stage_end(w, &w->last.time_projection, ts);
         if (pr < 0) goto oom;
         if (pr > 0)
             return step_failed(w, backup, time0, LC_ERR_NUMERIC,
@@ -996,6 +1025,7 @@ lc_status lc_world_step(lc_world *w, double dt)
     }
     for (i = 0; i < w->count * 6; ++i)
         if (!isfinite(w->state[i])) return step_failed(w, backup, time0, LC_ERR_NUMERIC, "the state became non-finite");
+    lc_stage_end(w, &w->last.time_step, w->step_t0);
     add_counters(&w->total, &w->last);
     w->error[0] = '\0';
     return LC_OK;

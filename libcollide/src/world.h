@@ -64,6 +64,8 @@ struct lc_world {
     lc_world_def def;
     double time;
     char error[256];
+    int stage_timing;        /* lc_world_set_stage_timing: fill the counters' time_* fields */
+    double step_t0;          /* stage clock at the start of the current step */
 
     /* bodies, dense rows in insertion order */
     int count, capacity;
@@ -223,6 +225,14 @@ double lc_pair_time_of_impact(lc_world *w, const double *s0, double h, int a, in
 
 /* ---- energy.c ---- */
 void lc_compute_energy(const lc_world *w, const double *state, lc_energy *out);
+
+/* Stage timing (stage_timing.c): t0 = lc_stage_begin(w); ...; lc_stage_end(w, &w->last.time_x, t0). */
+double lc_stage_clock(void);
+static inline double lc_stage_begin(const lc_world *w) { return w->stage_timing ? lc_stage_clock() : 0.0; }
+static inline void lc_stage_end(const lc_world *w, double *field, double t0)
+{
+    if (w->stage_timing) *field += lc_stage_clock() - t0;
+}
 
 /* Cosine and sine of body `row` at `angle`. A step asks for the same few states' trig many times
  * (broad phase, crossings, separation, touches: it was 40 % of the seed scene's time), so the last

@@ -319,8 +319,12 @@ class World:
         return Energy(e.translational, e.rotational, e.gravitational, e.spring, e.total,
                       _vec(e.linear_momentum), e.angular_momentum)
 
+    def set_stage_timing(self, on: bool) -> None:
+        """Measure wall time per pipeline stage into the counters' time_* fields (s); off by default."""
+        check(self._w, lib.lc_world_set_stage_timing(self._w, 1 if on else 0))
+
     def counters(self, last: bool = True) -> dict[str, Any]:
-        """Work counters of the last step (last=True) or since creation."""
+        """Work counters of the last step (last=True) or since creation (time_* in s: set_stage_timing)."""
         c = ffi.new("lc_counters *")
         if last:
             check(self._w, lib.lc_world_get_counters(self._w, c, ffi.NULL))

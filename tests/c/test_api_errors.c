@@ -228,6 +228,9 @@ static void world_def_errors(lc_world *w)
     EXPECT(w, lc_world_step(w, 0.0), LC_ERR_OUT_OF_RANGE, "dt");
     EXPECT(w, lc_world_step(w, -0.01), LC_ERR_OUT_OF_RANGE, "dt");
     EXPECT(w, lc_world_step(w, 1.5), LC_ERR_OUT_OF_RANGE, "dt");
+    EXPECT(w, lc_world_set_stage_timing(w, 2), LC_ERR_OUT_OF_RANGE, "stage timing");
+    EXPECT(w, lc_world_set_stage_timing(w, -1), LC_ERR_OUT_OF_RANGE, "stage timing");
+    CHECK(lc_world_set_stage_timing(NULL, 1) == LC_ERR_NULL, "%s", "lc_world_set_stage_timing(NULL) is LC_ERR_NULL");
 }
 
 /* ---- bodies ------------------------------------------------------------------------------------ */

@@ -6,7 +6,13 @@
  * (3) broadphase AUTO (the *_steps counters count detections, >= 1 per step): 3 bodies -> brute
  *     force in every detection, never sort-and-sweep; 200 bodies -> sort-and-sweep every step,
  *     producing far fewer candidate pairs than the 19900 of brute force; around the default
- *     threshold (32): 31 bodies brute force, 32 sort-and-sweep; forced modes are obeyed. */
+ *     threshold (32): 31 bodies brute force, 32 sort-and-sweep; forced modes are obeyed.
+ * (4) stage timing: off by default (every time_* counter exactly 0); on, a scene with impacts and
+ *     resting contact spends time in every stage, the six disjoint stages sum to no more than the
+ *     whole step (they do not overlap; the remainder is bookkeeping between them), and the contact
+ *     force solves fit inside the integration and time-of-impact stages that run them; off again,
+ *     no more time is added; 2 is refused with a message. The physics is the same bit for bit. */
+#include <string.h>
 #include "check.h"
 #include "scenes.h"
 
@@ -139,6 +145,62 @@ static void broadphase_equivalence(void)
     lc_world_destroy(w[1]);
 }
 
+/* Seven blocks of 0.5 m dropped onto a floor at e = 0.5 and onto each other: impacts, TOI searches,
+ * resting contact and projections all happen within the 200 steps. Returns the state hash. */
+static uint64_t timed_pile(int timing, lc_counters *tot)
+{
+    lc_world_def d = lc_default_world_def();
+    lc_world *w = sc_world(&d);
+    uint64_t h;
+    int i;
+    if (!w) return 0;
+    lc_world_add_walls(w, -3.0, 0.0, 3.0, 10.0, 1.0, 0.5, NULL);
+    for (i = 0; i < 7; i++)
+        sc_box(w, 0.5, 0.5, -1.2 + 0.4 * i, 0.6 + 0.7 * i, 0.1 * i, 0, 0, 0, 1.0, 0.5);
+    CHECK(lc_world_set_stage_timing(w, timing) == LC_OK, "%s", "stage timing set");
+    sc_step_n(w, 0.01, 200);
+    lc_world_get_counters(w, NULL, tot);
+    h = lc_world_state_hash(w);
+    if (timing) {
+        CHECK(lc_world_set_stage_timing(w, 2) == LC_ERR_OUT_OF_RANGE && strstr(lc_world_last_error(w), "not 2") != NULL,
+              "stage timing 2 refused with a message (%s)", lc_world_last_error(w));
+        lc_world_set_stage_timing(w, 0);
+        {
+            lc_counters after;
+            sc_step_n(w, 0.01, 10);
+            lc_world_get_counters(w, NULL, &after);
+            CHECK(after.time_step == tot->time_step && after.steps == tot->steps + 10,
+                  "%s", "timing off: steps counted, no time added");
+        }
+    }
+    lc_world_destroy(w);
+    return h;
+}
+
+static void stage_timing(void)
+{
+    lc_counters off, on;
+    uint64_t h_off = timed_pile(0, &off), h_on = timed_pile(1, &on);
+    double stages = on.time_detection + on.time_integration + on.time_toi_search + on.time_impulses + on.time_projection;
+    printf("stage timing, 200 steps of a 7-block pile: step %.3e s = detection %.3e + integration %.3e + toi %.3e + "
+           "impulses %.3e + projection %.3e (+ %.3e between); contact forces %.3e inside; %llu impacts\n",
+           on.time_step, on.time_detection, on.time_integration, on.time_toi_search, on.time_impulses,
+           on.time_projection, on.time_step - stages, on.time_contact_forces, (unsigned long long)on.collisions);
+    CHECK(off.time_step == 0.0 && off.time_detection == 0.0 && off.time_integration == 0.0 && off.time_toi_search == 0.0 &&
+          off.time_impulses == 0.0 && off.time_projection == 0.0 && off.time_contact_forces == 0.0,
+          "%s", "timing off by default: every time_* counter is 0");
+    CHECK(h_on == h_off, "%s", "timing changes no physics (same state hash)");
+    CHECK(on.collisions > 0 && on.toi_searches > 0 && on.contact_solves > 0 && on.position_projections > 0,
+          "the scene exercises every stage (impacts %llu, toi %llu, contact solves %llu, projections %llu)",
+          (unsigned long long)on.collisions, (unsigned long long)on.toi_searches,
+          (unsigned long long)on.contact_solves, (unsigned long long)on.position_projections);
+    CHECK(on.time_detection > 0.0 && on.time_integration > 0.0 && on.time_toi_search > 0.0 && on.time_impulses > 0.0 &&
+          on.time_projection > 0.0 && on.time_contact_forces > 0.0, "%s", "time measured in every stage");
+    CHECK(stages <= on.time_step, "disjoint stages sum to %.6e s, more than the whole steps' %.6e s", stages, on.time_step);
+    CHECK(on.time_contact_forces <= on.time_integration + on.time_toi_search + on.time_detection,
+          "%s", "contact forces run inside integration (and the TOI searches' and swept checks' integrations)");
+}
+
 int main(void)
 {
     nothing_touches();
@@ -150,5 +212,6 @@ int main(void)
     broadphase(3, LC_BROADPHASE_SORT_AND_SWEEP, 1);
     broadphase(40, LC_BROADPHASE_BRUTE_FORCE, 0);
     broadphase_equivalence();
+    stage_timing();
     return CHECK_SUMMARY("test_counters");
 }

@@ -3,6 +3,7 @@ error mapping. Only the public C API is used (through collide's cffi module)."""
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 import pytest
@@ -205,6 +206,23 @@ def test_energy_and_counters_types() -> None:
     w.step(0.01)
     last, total = w.counters(), w.counters(last=False)
     assert last["steps"] == 1 and total["steps"] == 1 and set(last) >= {"collisions", "contact_solves"}
+
+
+def test_stage_timing_fills_the_time_counters() -> None:
+    def run(timing: bool) -> tuple[dict[str, Any], int]:
+        w = collide.default_scene(blocks=3).build()
+        w.set_stage_timing(timing)
+        w.step(0.01, steps=100)
+        return w.counters(last=False), w.state_hash()
+    off, h_off = run(False)
+    on, h_on = run(True)
+    times = [k for k in on if k.startswith("time_")]
+    assert set(times) >= {"time_step", "time_detection", "time_integration", "time_contact_forces"}
+    assert all(off[k] == 0.0 for k in times)  # off by default
+    assert on["time_step"] > 0.0 and on["time_detection"] > 0.0 and on["time_integration"] > 0.0
+    disjoint = ("time_detection", "time_integration", "time_toi_search", "time_impulses", "time_projection")
+    assert sum(on[k] for k in disjoint) <= on["time_step"]
+    assert h_on == h_off  # measuring changes no physics
 
 
 def test_state_hash_is_deterministic() -> None:

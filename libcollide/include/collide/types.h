@@ -206,6 +206,16 @@ typedef struct lc_counters {
     uint64_t position_projections;    /* end-of-step corrections of points found inside another body */
     double max_lcp_residual;          /* largest residual of an iterative contact-force solve: relative for
                                          groups up to lcp_exact_max, m/s^2 of relative acceleration above */
+    /* s of wall time per pipeline stage, measured only while lc_world_set_stage_timing is on (else 0).
+     * The first six do not overlap and sum to at most time_step; time_contact_forces lies inside
+     * time_integration and time_toi_search (the integrator solves the contact forces). */
+    double time_step;                 /* the whole lc_world_step */
+    double time_detection;            /* broadphase, touches, crossings, swept checks */
+    double time_integration;          /* advancing the world over trial intervals and to event times */
+    double time_toi_search;           /* time-of-impact searches (their own integrations included) */
+    double time_impulses;             /* impulse solves of impacts */
+    double time_projection;           /* end-of-step position projection */
+    double time_contact_forces;       /* resting-contact force solves, wherever they ran */
 } lc_counters;
 
 #endif /* COLLIDE_TYPES_H */
