@@ -96,7 +96,7 @@ static int warm_start(lc_world *w, lc_touch *t, int n)
 }
 
 /* Resting set: touching points that approach no faster than resting_speed and separate no faster
- * than resting_speed (resting_speed / 100 between elastic bodies, see below).
+ * than resting_speed (resting_speed / 100 between perfectly elastic bodies, see below).
  * Touches already inside the contact gap that still approach faster than that are impacts that no
  * crossing test can see any more (they start inside); they are resolved here, before the step.
  * Returns the resting count, -1 (no memory) or -2 (a point has passed deep into another body: the
@@ -147,22 +147,24 @@ static int gather_resting(lc_world *w, double *state, int *impacts, const uint8_
      * crossing test cannot see it (a crossing starts above that depth), so if it turned back in (a
      * block rolling over a corner) only a contact force can stop it. A separating point above that
      * depth is left free, or a bouncing body would feel a sticky force.
-     * A point at the gap between elastic bodies (e > 0) that separates faster than resting_speed /
-     * 100 is left free as well, for the whole interval: a force on it holds apart two bodies that
-     * part (the target a >= -vn/h lets vn decay by e^-1 per step), and its work f vn > 0 is energy
-     * from nowhere where the exact answer is a bounce. In the touching cradle (tests/c/
+     * A point at the gap between perfectly elastic bodies (e = 1) that separates faster than
+     * resting_speed / 100 is left free as well, for the whole interval: a force on it holds apart two
+     * bodies that part (the target a >= -vn/h lets vn decay by e^-1 per step), and its work f vn > 0
+     * is energy from nowhere where the exact answer is a bounce. In the touching cradle (tests/c/
      * test_hard_cradle.c), blocks that part at up to 6e-5 m/s after an impact while their rotation
      * turns them back gained 4.8e-8 J that way. Left free, they part and meet again as a slow
-     * impact or a resting touch (-1.7e-9 J over the 60 s; the same from resting_speed / 300 to / 3).
+     * impact or a resting touch (-1.5e-9 J over the 60 s; the same from resting_speed / 300 to / 3).
      * Below resting_speed / 100 a touch keeps its force: that is the solver's noise on a touch at
      * rest (~1e-9 m/s), and leaving those free turns resting touches into a chatter of tiny impacts
-     * (at / 1e5: -1.8e-8 J in the cradle, 1-3 slow impacts a step). Inelastic pairs (e = 0) keep
-     * the force at any separating speed up to resting_speed: the exact answer there is a landing,
-     * which the force gives, and leaving them free set off an impact storm in a six-block pile
-     * (tests/c/test_pile.c, e = 0: 277 impacts in 10 s became 840 000 by 8.7 s). */
+     * (at / 1e5: -1.8e-8 J in the cradle, 1-3 slow impacts a step). Pairs with e < 1 keep the force
+     * at any separating speed up to resting_speed: their contacts dissipate, by far more than the
+     * force's work (at most f vn h per parting), and freeing them made a chatter of slow impacts:
+     * bench/run's 20-block settling scene at e = 0.8 went from 8.3 to 32.5 impacts and from 2.4 to
+     * 15.5 ms per step, and an e = 0 six-block pile (tests/c/test_pile.c) from 277 impacts in 10 s
+     * to 840 000 by 8.7 s. */
     for (i = 0; i < n; ++i)
         if ((t[i].vn >= -w->def.resting_speed &&
-             t[i].vn <= (t[i].elasticity > 0.0 ? 1e-2 : 1.0) * w->def.resting_speed) ||
+             t[i].vn <= (t[i].elasticity >= 1.0 ? 1e-2 : 1.0) * w->def.resting_speed) ||
             (t[i].gap < -0.5 * w->def.contact_gap && t[i].vn > 0.0))
             t[k++] = t[i];
     if (warm_start(w, t, k) != 0) return -1;
