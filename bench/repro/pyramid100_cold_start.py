@@ -1,0 +1,41 @@
+"""libcollide repro: pyramid base 100 (5050 boxes) does not finish bench/run's first chunk of 15 steps.
+
+Box2D's large_pyramid layout (unit boxes, 1 kg, mu 0.6, e 0, g 10, dt 1/60) on a ground box, exactly
+touching. Each step prints its CPU time and the counters that explain it: the first step solves the
+contact forces from zero in a 100-layer pile, and MPRGP (sparse_lcp.c) stops at its product budget
+with a residual far above its tolerance (max_lcp_residual, m/s^2); the drift that leaves then sets off
+time-of-impact searches in the next step, each of which integrates (and re-solves) the whole pile.
+The script stops after --cpu seconds of CPU (default 120) or --steps steps (default 3), whichever
+comes first; a step in progress is not interrupted.
+
+    source scripts/env.sh && python bench/repro/pyramid100_cold_start.py [--base 100] [--steps 3] [--cpu 120]
+"""
+import argparse
+import time
+
+import collide
+
+ap = argparse.ArgumentParser()
+ap.add_argument("--base", type=int, default=100)
+ap.add_argument("--steps", type=int, default=3)
+ap.add_argument("--cpu", type=float, default=120.0)
+a = ap.parse_args()
+w = collide.World(gravity=(0.0, -10.0), damping=0.0)
+for i in range(a.base):
+    for j in range(i, a.base):
+        x = (i + 1.0) * 0.5 + (j - i) * 1.0 - 0.5 * a.base
+        w.add_box(1.0, 1.0, position=(x, 0.5 + i), mass=1.0, elasticity=0.0, friction=0.6)
+w.add_box(2.0 * a.base + 20.0, 1.0, position=(0.0, -0.5), static=True, elasticity=0.0, friction=0.6)
+total = 0.0
+for k in range(a.steps):
+    t0 = time.process_time()
+    w.step(1 / 60)
+    dt = time.process_time() - t0
+    total += dt
+    c = w.counters(last=True)
+    print(f"step {k + 1}: {dt:.2f} s CPU; contact solves {c['contact_solves']}, products {c['contact_solve_iterations']}, "
+          f"residual {c['max_lcp_residual']:.3g} m/s^2, TOI searches {c['toi_searches']}, collisions {c['collisions']}, "
+          f"projections {c['position_projections']}", flush=True)
+    if total > a.cpu:
+        print(f"stopping after {total:.0f} s of CPU")
+        break
