@@ -741,7 +741,9 @@ static int step_energy_blew_up(const lc_world *w, const double *backup, double d
     lc_energy e0, e1;
     double drive = 0.0;
     int i, k;
-    if (started_deep) return 0;
+    /* a step of integration alone (no impact, no contact force) is checked by its finite state; the
+     * balance costs ~5 % of a 20-block step and is kept for the steps where contacts acted */
+    if (started_deep || (w->last.collisions == 0 && w->last.contact_solves == 0)) return 0;
     for (i = 0; i < w->count; ++i) {
         const double *a = &backup[i * 6], *b = &w->state[i * 6];
         double f, tau, v, om;
