@@ -98,13 +98,25 @@ void lc_applied_accelerations(const lc_world *w, const double *state, const int 
     }
 }
 
+int lc_body_thrusting(const lc_world *w, int row)
+{
+    int k;
+    for (k = 0; k < w->thruster_count[row]; ++k)
+        if (w->thrusters[row][k].level != 0.0) return 1;
+    return 0;
+}
+
+int lc_body_driven(const lc_world *w, int row)
+{
+    return w->ext_force[row].x != 0.0 || w->ext_force[row].y != 0.0 || w->ext_torque[row] != 0.0 ||
+           lc_body_thrusting(w, row);
+}
+
 int lc_body_forces_constant(const lc_world *w, int row)
 {
     int k;
     lc_body_id id = w->ids[row];
-    if (w->def.damping != 0.0) return 0;
-    for (k = 0; k < w->thruster_count[row]; ++k)
-        if (w->thrusters[row][k].level != 0.0) return 0;
+    if (w->def.damping != 0.0 || lc_body_thrusting(w, row)) return 0;
     for (k = 0; k < w->spring_count; ++k)
         if (w->springs[k].def.body_a == id || w->springs[k].def.body_b == id) return 0;
     return 1;

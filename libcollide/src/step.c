@@ -715,7 +715,8 @@ static int contact_energy_blew_up(const lc_world *w, const double *s0, const dou
         if (!mark[i]) continue;
         mark[i] = 0;
         if (w->is_static[i]) continue;
-        if (w->ext_force[i].x != 0.0 || w->ext_force[i].y != 0.0 || w->ext_torque[i] != 0.0) verdict = 0;
+        if (lc_body_driven(w, i)) verdict = 0;   /* thrusters too: a 100 N thruster on a block resting on
+                                                   * the floor failed its first step here */
         m = w->inv_mass[i] > 0.0 ? 1.0 / w->inv_mass[i] : 0.0;
         in = w->inv_inertia[i] > 0.0 ? 1.0 / w->inv_inertia[i] : 0.0;
         ke0 += 0.5 * m * (a[SVX] * a[SVX] + a[SVY] * a[SVY]) + 0.5 * in * a[SW] * a[SW];

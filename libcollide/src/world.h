@@ -145,6 +145,10 @@ static inline lc_vec2 lc_rot_inv(double c, double s, lc_vec2 a) { return lc_v(c 
 void lc_applied_accelerations(const lc_world *w, const double *state, const int *rows, int n, double *acc);
 /* 1 if a body's applied forces are constant over time (so it may be advanced in closed form). */
 int lc_body_forces_constant(const lc_world *w, int row);
+/* 1 if any of body `row`'s thrusters fires (level != 0). */
+int lc_body_thrusting(const lc_world *w, int row);
+/* 1 if something outside the contacts drives body `row`: an external force or torque, or a thruster. */
+int lc_body_driven(const lc_world *w, int row);
 
 /* ---- narrow_phase.c ---- */
 /* Geometry of a vertex/edge touch at `state`; fills p, n, ra, rb, gap, vn. */
