@@ -198,6 +198,19 @@ class SimClient:
                 return vals
         return None
 
+    def wait_node_matched(self, topic: str, timeout: float = 20.0) -> bool:
+        """Wait until the node's writer on ``topic`` has matched every reader the graph lists,
+        by its own subscribers/<topic> diagnostic. A reader that sees the writer
+        (get_publisher_count) may still miss messages: DDS matches the two ends separately."""
+        name = topic if topic.startswith("/") else f"{self.ns}/{topic}"
+        key = topic.lstrip("/")
+
+        def matched() -> bool:
+            vals = self.diagnostics(timeout=min(5.0, timeout))
+            listed = len(self.node.get_subscriptions_info_by_topic(name))
+            return vals is not None and listed > 0 and int(vals.get(f"subscribers/{key}", -1)) >= listed
+        return self.wait_for(matched, timeout)
+
     def settled_counts(self, timeout: float = 20.0) -> dict[str, int] | None:
         """The node's message counts once they stopped changing: two consecutive /diagnostics
         messages of a paused node with equal counts, apart from published/diagnostics (the node

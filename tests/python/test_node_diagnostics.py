@@ -184,7 +184,9 @@ def test_commands_dropped_while_the_executor_is_busy_are_counted_lost(sim: SimCl
     echoes: list[ThrusterCommand] = []
     sub = sim.node.create_subscription(ThrusterCommand, "applied/thrusters", echoes.append, 100)
     try:
-        assert sim.wait_for(lambda: sub.get_publisher_count() > 0, 10.0)
+        # our reader seeing the node's writer is not enough: the echo reaches us only once the
+        # node's writer has matched our reader, which DDS may do later (a CI run lost the echo)
+        assert sim.wait_node_matched("applied/thrusters")
         sim.publish("thrusters", ThrusterCommand(body="block1", firing=[False]))  # the node's first from us
         assert sim.wait_for(lambda: len(echoes) >= 1, 10.0)
         _pause(sim, True)
