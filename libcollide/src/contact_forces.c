@@ -53,9 +53,9 @@ static int solve_with_friction(lc_world *w, const double *state, lc_touch *sub, 
     double *A = lc_buf_get(&w->b_mat, (size_t)n2 * (size_t)n2 * sizeof(double));
     double *b = lc_buf_get(&w->b_vec, (size_t)n2 * 8 * sizeof(double));
     double *f, *Ann, *bn, *bt, *lo, *hi, *fold, viol = 0.0;
-    /* a thousandth of the large groups' tolerance (see solve_large_group): at theirs a 1:1000
-     * mass-ratio stack crept 1.6e-8 m in 60 s, at this one 3e-12 m; the settling scene (20 blocks,
-     * e 0.8, mu 0.5) then costs ~27 ms per step against ~10 ms at theirs */
+    /* a hundredth of the large groups' tolerance (see solve_large_group): at 2.5e-4 contact_gap / h^2
+     * a 1:1000 mass-ratio stack crept 1.6e-8 m in 60 s, at this one 3e-12 m; the settling scene (20
+     * blocks, e 0.8, mu 0.5) then cost ~27 ms per step against ~10 ms at the looser one */
     double tol = 2.5e-7 * w->def.contact_gap / (h * h);
     lc_lcp_result res;
     if (!A || !b) return -1;
@@ -136,11 +136,13 @@ static int solve_with_friction(lc_world *w, const double *state, lc_touch *sub, 
  * the normal rows with the friction forces held, then, with friction, the tangent rows boxed by the
  * Coulomb cone of those normal forces, alternated until the friction forces stop changing what the
  * normal rows see (a resting pile carries little friction: one or two rounds). Warm-started from the
- * touches' previous forces. Converged when the unresolved relative acceleration would move a point
- * by less than 2.5e-4 contact_gap over the step (9e-8 m/s^2 at 1/60 s): a direction nothing holds
- * (a frictionless box sideways) integrates what is left into a creep, ~t^2/2 of it; a quarter of the
- * gap (100x looser) let the frictionless pyramid creep 1e-4 m in 10 s, and a warm-started pile needs
- * hardly more products at this one. Returns products of A used, or -1. */
+ * touches' previous forces, or, when none has one, from the weights they carry (static_load.c).
+ * Converged when the unresolved relative acceleration would move a point by less than 2.5e-5
+ * contact_gap over the step (9e-9 m/s^2 at 1/60 s): a direction nothing holds (a frictionless box
+ * sideways) integrates what is left into a creep, ~t^2/2 of it. At 10x this tolerance the
+ * frictionless base-20 pyramid crept 4.1e-4 m in 60 s (its bound is 1e-4 m), at this one 4.9e-5 m;
+ * a warm pile needs 8-40 products per step here against 10-17 there (base 100: 0.04-0.05 s per step
+ * either way: the products are no longer most of its cost). Returns products of A used, or -1. */
 static int solve_large_group(lc_world *w, const double *state, lc_touch *sub, int m, const double *acc, double kv,
                              double kd, double h, int with_friction, double *resid)
 {
@@ -150,7 +152,7 @@ static int solve_large_group(lc_world *w, const double *state, lc_touch *sub, in
     int i, round, k, products = 0, budget = 5 * w->def.lcp_max_iterations;
     if (v == NULL || body == NULL) return -1;
     bn = v; bt = bn + m; fn = bt + m; ft = fn + m; lo = ft + m; hi = lo + m; rhs = hi + m; ft_old = rhs + m;
-    tol = 0.00025 * w->def.contact_gap / (h * h);
+    tol = 2.5e-5 * w->def.contact_gap / (h * h);
     for (i = 0; i < m; ++i) {
         bn[i] = free_acceleration(w, state, &sub[i], acc, sub[i].n) + kv * sub[i].vn +
                 kd * (sub[i].gap - w->def.contact_gap);
@@ -158,6 +160,9 @@ static int solve_large_group(lc_world *w, const double *state, lc_touch *sub, in
         fn[i] = sub[i].value > 0.0 && isfinite(sub[i].value) ? sub[i].value : 0.0;
         ft[i] = with_friction && isfinite(sub[i].tangent) ? sub[i].tangent : 0.0;
     }
+    /* a cold pile (no touch has a force yet): start from the weights it carries (static_load.c) */
+    for (i = 0; i < m && fn[i] == 0.0; ++i) {}
+    if (i == m && lc_static_load_forces(w, sub, m, fn) != 0) return -1;
     for (round = 0; round < (with_friction ? LC_FRICTION_ROUNDS : 1); ++round) {
         double moved = 0.0;
         /* normal rows, the friction forces held */

@@ -332,6 +332,11 @@ static int project_sparse(lc_world *w, const lc_touch *t, int n)
         lo[i] = 0.0;
         hi[i] = INFINITY;
     }
+    /* start from lifting each body by the gaps below it (static_load.c); hi is scratch for the
+     * deficits until then */
+    for (i = 0; i < n; ++i) hi[i] = -b[i];
+    if (lc_static_load_lifts(w, t, n, hi, lam) != 0) return -1;
+    for (i = 0; i < n; ++i) hi[i] = INFINITY;
     if (lc_sparse_lcp(w, t, n, 0, b, lo, hi, lam, 1e-3 * w->def.contact_gap, 25 * w->def.lcp_max_iterations,
                       &viol) < 0)
         return -1;

@@ -100,19 +100,21 @@ struct lc_world {
     lc_buf b_touch, b_rest, b_pairs, b_aabb, b_rows, b_island, b_flags, b_mat, b_vec, b_vec2, b_order;
     lc_buf b_step_scratch;   /* step.c only: held across the whole step, so no other file may use it */
     lc_buf b_sample0, b_sample1; /* step.c only: sub-interval states of the swept check */
-    lc_buf b_swept;
+    lc_buf b_swept;          /* step.c only: the whole world at the swept check's sub-times */
     lc_buf b_rkeys;
     lc_buf b_emark;          /* step.c only: bodies under resting contact, for the energy check */
     lc_buf b_isl, b_isl_touch, b_isl_pick, b_isl_pick_touch; /* step.c only: islands of a pass */
     lc_buf b_sparse, b_sparse_body; /* sparse_lcp.c: its vectors and the bodies' responses */
     double sparse_norm[2];   /* sparse_lcp.c: last ||A|| estimate of normal [0] and tangent [1] rows, */
     int sparse_norm_rows[2]; /* and its row count: a pile's A changes little from one solve to the next */
-    lc_buf b_group_rows;     /* contact_forces.c: right-hand sides, bounds and forces of a large group */          /* step.c only: hash of the resting vertices of a pass */          /* step.c only: the whole world at the swept check's sub-times */
+    lc_buf b_group_rows;     /* contact_forces.c: right-hand sides, bounds and forces of a large group */
+    lc_buf b_load, b_load_graph; /* static_load.c: per-body loads, and the graph of who rests on whom */
     lc_buf b_dirty, b_drows; /* step.c only: bodies whose motion the last impact changed */
     lc_buf b_group;          /* step.c only: bodies of an impact group, in the order found */
     int cross_count;         /* step.c only: crossings in b_cross at the end of the last pass */
     lc_buf b_fric;           /* impulse.c: friction rows of an impact */
     lc_buf b_cfric;          /* contact_forces.c: normal and tangent blocks of a friction group */
+    /* b_hash, step.c only: hash of the resting vertices of a pass */
     lc_buf b_cross, b_impact, b_irows, b_coupled, b_dacc, b_diag, b_warm, b_hash;
     int warm_count;          /* resting touches kept in b_warm from the previous pass (warm start) */
     double step_dt;          /* dt of the step in progress (stabilisation time scale) */
@@ -200,6 +202,15 @@ static inline lc_vec2 lc_tangent_of(lc_vec2 n) { return lc_v(-n.y, n.x); }
  * memory); *violation = largest entry of the projected gradient (units of b). */
 int lc_sparse_lcp(lc_world *w, const lc_touch *t, int m, int tangent, const double *b, const double *lo,
                   const double *hi, double *x, double tol, int max_products, double *violation);
+
+/* ---- static_load.c ---- */
+/* Starting guesses for a cold pile's sparse solves (only touches a body rests on get one; f, lam must
+ * hold zeros). Each returns 0 (no gravity: no guess), or -1 on allocation failure. */
+/* f[i]: N, the weight each touch carries when loads are shared equally among a body's supports. */
+int lc_static_load_forces(lc_world *w, const lc_touch *t, int m, double *f);
+/* lam[i]: kg*m, the projection's multipliers that lift every body by the gaps below it (deficit[i], m,
+ * what touch i is short of the contact gap). */
+int lc_static_load_lifts(lc_world *w, const lc_touch *t, int m, const double *deficit, double *lam);
 
 /* ---- contact_forces.c ---- */
 /* Adds resting contact forces for touches[0..n) into acc (rows indexed), solving the contact LCP.

@@ -10,13 +10,15 @@
  * <= 1e-9 m):
  *  - every box stays put: |x - x0| and |y - y0| <= 1e-4 m, tilt <= 1e-5 rad. The exact answer is 0;
  *    contacts are held at gap contact_gap = 1e-7 m, so the top (row 20) may rise by 20 * 1e-7 = 2e-6 m;
- *    the sparse solver stops when the unresolved relative acceleration is below 2.5e-4 contact_gap /
- *    h^2 = 9e-8 m/s^2 (contact_forces.c), which the velocity stabilisation stops every step where a
- *    contact holds (with friction, every direction of every box here); uncorrected over 60 s it
- *    would be 9e-8 * 60^2 / 2 = 1.6e-4 m. 1e-4 m is 10 contact_distances and 300 x below Box2D v3's
- *    top-box motion of 3 cm in 8 s;
- *  - at rest: |v| <= 1e-5 m/s and |omega| <= 1e-5 rad/s (a residual of 9e-8 m/s^2 over one step is
- *    1.5e-9 m/s; anything near 1e-5 is jitter);
+ *    the sparse solver stops when the unresolved relative acceleration is below 2.5e-5 contact_gap /
+ *    h^2 = 9e-9 m/s^2 (contact_forces.c), which the velocity stabilisation stops every step where a
+ *    contact holds; in a direction nothing holds (frictionless, sideways) it integrates into a creep:
+ *    uncorrected over 60 s 9e-9 * 60^2 / 2 = 1.6e-5 m. Measured: 4.9e-5 m (box 209), more than that
+ *    estimate, so the residual is not the creep's only source (not yet explained); at a 10x looser
+ *    tolerance 4.1e-4 m, which failed this bound.
+ *    1e-4 m is 10 contact_distances and 300 x below Box2D v3's top-box motion of 3 cm in 8 s;
+ *  - at rest: |v| <= 1e-5 m/s and |omega| <= 1e-5 rad/s (a residual of 9e-9 m/s^2 over one step is
+ *    1.5e-10 m/s; over 60 s 5.4e-7 m/s; anything near 1e-5 is jitter);
  *  - energy (computed here) never rises or falls by more than sum m g 1e-4 m (the position bound);
  *  - no impacts: faces start touching and nothing approaches (budget: one per box, run stops beyond);
  *  - at the end the ground's contact forces carry the whole weight, 210 * 10 N, to 1e-6 relative. */
@@ -106,7 +108,7 @@ static void pyramid(double mu, const char *label)
 
 int main(void)
 {
-    /* the frictionless case is pending/test_hard_pyramid_frictionless.c (docs/hard_cases.md) */
     pyramid(0.6, "pyramid base 20, mu = 0.6");
+    pyramid(0.0, "pyramid base 20, frictionless");
     return CHECK_SUMMARY("test_hard_pyramid");
 }
