@@ -141,21 +141,37 @@ int lc_broad_phase(lc_world *w, const double *s0, const double *s1, double margi
 int lc_broad_phase_of(lc_world *w, const double *s0, const double *s1, double margin, const uint8_t *marked,
                       const int *list, int nlist, lc_buf *buf)
 {
-    int n = w->count, k, j, count = 0;
+    int n = w->count, a, b, k, first = 0, count = 0;
     box *boxes = swept_boxes(w, s0, s1, margin);
-    if (boxes == NULL) return -1;
-    /* neither brute force nor sort-and-sweep over the world: not counted as either */
+    int *sorted = lc_buf_get(&w->b_marked_rows, (size_t)(nlist > 0 ? nlist : 1) * sizeof(int));
+    if (boxes == NULL || sorted == NULL) return -1;
+    /* the listed rows in row order (list is in the order the impact found them; a few rows, so an
+     * insertion sort), so the pairs come out in brute force's order (a, then b) without sorting them */
     for (k = 0; k < nlist; ++k) {
-        int i = list[k];
-        for (j = 0; j < n; ++j) {
-            if (j == i || (marked[j] && j < i)) continue;   /* a pair of two marked bodies once */
-            if (w->is_static[i] && w->is_static[j]) continue;
-            if (!overlap(&boxes[i], &boxes[j])) continue;
-            count = add_pair(buf, count, i, j);
-            if (count < 0) return -1;
+        int r = list[k], q = k;
+        while (q > 0 && sorted[q - 1] > r) { sorted[q] = sorted[q - 1]; --q; }
+        sorted[q] = r;
+    }
+    /* neither brute force nor sort-and-sweep over the world: not counted as either */
+    for (a = 0; a < n; ++a) {
+        if (marked[a]) {
+            for (b = a + 1; b < n; ++b) {
+                if (w->is_static[a] && w->is_static[b]) continue;
+                if (!overlap(&boxes[a], &boxes[b])) continue;
+                count = add_pair(buf, count, a, b);
+                if (count < 0) return -1;
+            }
+        } else {
+            while (first < nlist && sorted[first] <= a) ++first;
+            for (k = first; k < nlist; ++k) {
+                b = sorted[k];
+                if (w->is_static[a] && w->is_static[b]) continue;
+                if (!overlap(&boxes[a], &boxes[b])) continue;
+                count = add_pair(buf, count, a, b);
+                if (count < 0) return -1;
+            }
         }
     }
-    if (count > 1) qsort(buf->p, (size_t)count, 2 * sizeof(int), cmp_pair);
     w->last.broadphase_pairs += (uint64_t)count;
     return count;
 }

@@ -16,6 +16,25 @@
 #define LC_MAX_FORCE_EVALUATIONS_PER_STEP 500000u
 #define LC_MAX_SERIAL_ITERATIONS_PER_STEP 50000u
 
+/* The touches the last step's projection found at the state it ended in, moved into buf, if this
+ * gather is at that same state (-1: none kept, or something changed since). The first gather of a
+ * step is at the state the previous one ended in, so in a world at rest or in free flight one of the
+ * two whole-world touch searches per step is saved (the projection has to look at the end state,
+ * the next step's resting set at its start). One use: every later gather of the step is elsewhere. */
+static int kept_end_touches(lc_world *w, const double *state, lc_buf *buf)
+{
+    int n = w->end_touch_count;
+    lc_buf swap;
+    w->end_touch_count = -1;
+    if (n < 0 || w->end_edits != w->edits || state != w->state ||
+        memcmp(w->b_end_state.p, state, (size_t)w->count * 6 * sizeof(double)) != 0)
+        return -1;
+    swap = *buf;
+    *buf = w->b_end_touches;
+    w->b_end_touches = swap;
+    return n;
+}
+
 /* Touches at `state` with gap < contact_distance, appended to buf from 0: between all near pairs, or
  * (list != NULL) only the pairs with at least one of the listed bodies (marked[row] != 0). */
 static int gather_touches_of(lc_world *w, const double *state, const uint8_t *marked, const int *list, int nlist,
@@ -23,6 +42,8 @@ static int gather_touches_of(lc_world *w, const double *state, const uint8_t *ma
 {
     int np, i, n = 0;
     const int *pairs;
+    if (list == NULL && (n = kept_end_touches(w, state, buf)) >= 0) return n;
+    n = 0;
     np = list ? lc_broad_phase_of(w, state, state, w->def.contact_distance, marked, list, nlist, &w->b_pairs)
               : lc_broad_phase(w, state, state, w->def.contact_distance, &w->b_pairs);
     if (np < 0) return -1;
@@ -351,7 +372,8 @@ static int project_sparse(lc_world *w, const lc_touch *t, int n)
     return 1;
 }
 
-static int project_once(lc_world *w, double *deepest)
+/* 1 projected, 0 nothing to do (*found: the touches in b_impact, all at w->state), -1 no memory */
+static int project_once(lc_world *w, double *deepest, int *found)
 {
     int n = gather_touches(w, w->state, &w->b_impact), i, k = 0;
     lc_touch *t = (lc_touch *)w->b_impact.p;
@@ -359,6 +381,7 @@ static int project_once(lc_world *w, double *deepest)
     lc_lcp_options opt;
     lc_lcp_result res;
     *deepest = INFINITY;
+    *found = n;
     if (n <= 0) return n;
     for (i = 0; i < n; ++i) {
         if (t[i].gap < 0.5 * w->def.contact_gap) k = 1;
@@ -397,13 +420,24 @@ static int project_once(lc_world *w, double *deepest)
 /* 0 done, 1 still overlapping after every pass (forces far beyond what dt can resolve), -1 no memory. */
 static int project_positions(lc_world *w)
 {
-    int pass, r = 0;
+    int pass, r = 0, found = 0;
     double deepest = INFINITY;
     for (pass = 0; pass <= LC_PROJECTION_PASSES; ++pass) {
-        r = project_once(w, &deepest);
+        r = project_once(w, &deepest, &found);
         if (r <= 0) break;
     }
     if (r < 0) return -1;
+    if (r == 0) {
+        /* the last search was at the state the step ends in: keep it for the next step's first gather */
+        double *kept = lc_buf_get(&w->b_end_state, (size_t)w->count * 6 * sizeof(double));
+        lc_buf swap = w->b_impact;
+        if (kept == NULL) return -1;
+        memcpy(kept, w->state, (size_t)w->count * 6 * sizeof(double));
+        w->b_impact = w->b_end_touches;
+        w->b_end_touches = swap;
+        w->end_touch_count = found;
+        w->end_edits = w->edits;
+    }
     /* the last pass projected again: its touches were measured before that pass */
     if (r > 0 && deepest < -LC_OVERLAP_TOLERANCE) return 1;
     return 0;

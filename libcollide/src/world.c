@@ -193,6 +193,7 @@ lc_world *lc_world_create(const lc_world_def *def, char *errbuf, size_t errbuf_l
     }
     w->def = *def;
     w->next_body_id = 1;
+    w->end_touch_count = -1;
     w->next_spring_id = 1;
     if (errbuf && errbuf_len) errbuf[0] = '\0';
     return w;
@@ -212,7 +213,7 @@ void lc_world_destroy(lc_world *w)
     lc_buf_free(&w->b_tmp); lc_buf_free(&w->b_acc); lc_buf_free(&w->b_touch); lc_buf_free(&w->b_rest);
     lc_buf_free(&w->b_pairs); lc_buf_free(&w->b_aabb); lc_buf_free(&w->b_rows); lc_buf_free(&w->b_island);
     lc_buf_free(&w->b_flags); lc_buf_free(&w->b_mat); lc_buf_free(&w->b_vec); lc_buf_free(&w->b_vec2);
-    lc_buf_free(&w->b_step_scratch); lc_buf_free(&w->b_sample0); lc_buf_free(&w->b_sample1); lc_buf_free(&w->b_swept); lc_buf_free(&w->b_rkeys); lc_buf_free(&w->b_emark); lc_buf_free(&w->b_isl); lc_buf_free(&w->b_isl_touch); lc_buf_free(&w->b_isl_pick); lc_buf_free(&w->b_isl_pick_touch); lc_buf_free(&w->b_sparse); lc_buf_free(&w->b_sparse_body); lc_buf_free(&w->b_group_rows); lc_buf_free(&w->b_load); lc_buf_free(&w->b_load_graph); lc_buf_free(&w->b_dirty); lc_buf_free(&w->b_drows); lc_buf_free(&w->b_group); lc_buf_free(&w->b_fric); lc_buf_free(&w->b_cfric); lc_buf_free(&w->b_order); lc_buf_free(&w->b_cross);
+    lc_buf_free(&w->b_step_scratch); lc_buf_free(&w->b_sample0); lc_buf_free(&w->b_sample1); lc_buf_free(&w->b_swept); lc_buf_free(&w->b_end_touches); lc_buf_free(&w->b_end_state); lc_buf_free(&w->b_marked_rows); lc_buf_free(&w->b_rkeys); lc_buf_free(&w->b_emark); lc_buf_free(&w->b_isl); lc_buf_free(&w->b_isl_touch); lc_buf_free(&w->b_isl_pick); lc_buf_free(&w->b_isl_pick_touch); lc_buf_free(&w->b_sparse); lc_buf_free(&w->b_sparse_body); lc_buf_free(&w->b_group_rows); lc_buf_free(&w->b_load); lc_buf_free(&w->b_load_graph); lc_buf_free(&w->b_dirty); lc_buf_free(&w->b_drows); lc_buf_free(&w->b_group); lc_buf_free(&w->b_fric); lc_buf_free(&w->b_cfric); lc_buf_free(&w->b_order); lc_buf_free(&w->b_cross);
     lc_buf_free(&w->b_impact); lc_buf_free(&w->b_irows); lc_buf_free(&w->b_coupled); lc_buf_free(&w->b_dacc); lc_buf_free(&w->b_diag); lc_buf_free(&w->b_warm); lc_buf_free(&w->b_hash);
     free(w);
 }
@@ -261,6 +262,7 @@ lc_status lc_world_set_elasticity(lc_world *w, double e)
     if (w == NULL) return LC_ERR_NULL;
     CHECK_RANGE(w, e, 0.0, 1.0, "elasticity");
     for (i = 0; i < w->count; ++i) w->elasticity[i] = e;
+    w->edits++;
     return ok(w);
 }
 
@@ -352,6 +354,7 @@ lc_status lc_world_add_body(lc_world *w, const lc_body_def *d, lc_body_id *out_i
     if (!reserve_bodies(w, w->count + 1) || !reserve_id(w, w->next_body_id))
         return lc_fail(w, LC_ERR_NO_MEMORY, "out of memory adding a body");
     row = w->count++;
+    w->edits++;
     w->ids[row] = w->next_body_id;
     w->id_to_row[w->next_body_id] = row;
     if (out_id) *out_id = w->next_body_id;
@@ -464,6 +467,7 @@ lc_status lc_world_remove_body(lc_world *w, lc_body_id id)
     SHIFT(w->state, LC_STATE_SIZE);
 #undef SHIFT
     w->count--;
+    w->edits++;
     w->id_to_row[id] = -1;
     for (i = row; i < w->count; ++i) w->id_to_row[w->ids[i]] = i;
     remove_springs_of(w, id);
@@ -504,6 +508,7 @@ lc_status lc_world_set_state(lc_world *w, const double *state, int count)
     for (i = 0; i < count; ++i)
         if (!w->is_static[i]) memcpy(&w->state[i * 6], &state[i * 6], 6 * sizeof(double));
     w->contact_count = 0;
+    w->edits++;
     return ok(w);
 }
 
@@ -523,6 +528,7 @@ lc_status lc_body_set_pose(lc_world *w, lc_body_id id, lc_vec2 center, double an
     w->state[row * 6 + SY] = center.y;
     w->state[row * 6 + SA] = angle;
     w->contact_count = 0;
+    w->edits++;
     return ok(w);
 }
 
@@ -535,6 +541,7 @@ lc_status lc_body_set_velocity(lc_world *w, lc_body_id id, lc_vec2 v, double ome
     w->state[row * 6 + SVX] = v.x;
     w->state[row * 6 + SVY] = v.y;
     w->state[row * 6 + SW] = omega;
+    w->edits++;
     return ok(w);
 }
 
@@ -548,6 +555,7 @@ lc_status lc_body_set_mass(lc_world *w, lc_body_id id, double mass)
     w->inertia[row] = mass * w->shape[row].unit_inertia;
     w->inv_mass[row] = 1.0 / mass;
     w->inv_inertia[row] = 1.0 / w->inertia[row];
+    w->edits++;
     return ok(w);
 }
 
@@ -559,6 +567,7 @@ lc_status lc_body_set_material(lc_world *w, lc_body_id id, double e, double mu)
     CHECK_RANGE(w, mu, 0.0, 10.0, "friction");
     w->elasticity[row] = e;
     w->friction[row] = mu;
+    w->edits++;
     return ok(w);
 }
 

@@ -100,6 +100,7 @@ struct lc_world {
     lc_buf b_touch, b_rest, b_pairs, b_aabb, b_rows, b_island, b_flags, b_mat, b_vec, b_vec2, b_order;
     lc_buf b_step_scratch;   /* step.c only: held across the whole step, so no other file may use it */
     lc_buf b_sample0, b_sample1; /* step.c only: sub-interval states of the swept check */
+    lc_buf b_marked_rows;    /* broad_phase.c: the marked rows of lc_broad_phase_of in row order */
     lc_buf b_swept;          /* step.c only: the whole world at the swept check's sub-times */
     lc_buf b_rkeys;
     lc_buf b_emark;          /* step.c only: bodies under resting contact, for the energy check */
@@ -112,6 +113,12 @@ struct lc_world {
     lc_buf b_dirty, b_drows; /* step.c only: bodies whose motion the last impact changed */
     lc_buf b_group;          /* step.c only: bodies of an impact group, in the order found */
     int cross_count;         /* step.c only: crossings in b_cross at the end of the last pass */
+    /* step.c only: the touches the end-of-step projection found at the state the step ended in, for
+     * the next step's first gather when neither the state nor `edits` changed in between */
+    lc_buf b_end_touches, b_end_state;
+    int end_touch_count;     /* -1: none kept */
+    unsigned long end_edits;
+    unsigned long edits;     /* bumped by every API call that changes bodies, their states or materials */
     lc_buf b_fric;           /* impulse.c: friction rows of an impact */
     lc_buf b_cfric;          /* contact_forces.c: normal and tangent blocks of a friction group */
     /* b_hash, step.c only: hash of the resting vertices of a pass */

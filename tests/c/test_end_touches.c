@@ -1,0 +1,116 @@
+/* test_end_touches.c - the touches the end-of-step projection found are reused by the next step's first
+ * gather only while nothing has changed (step.c, kept_end_touches). A stale reuse would hand the step
+ * touches with the old materials or the old bodies; each case below would then fail its physics check.
+ * g = 9.81, dt = 1/60 s, a 1 m x 0.5 m, 1 kg box resting on a static floor.
+ *  - reuse happens: in a resting scene each step runs one whole-world broadphase for its trial and one
+ *    for the projection's search, and none for the resting set at its start (brute_force_steps = 2,
+ *    it was 3 before the reuse);
+ *  - friction set after a step counts at once: a resting box with mu 0 -> 1 under a 2 N push stays
+ *    put (static friction can give up to 9.81 N). With the old touches (mu 0) it would reach 2/60 m/s
+ *    = 3.3e-2 m/s in the first step. Bound 1e-6 m/s in that step: when a push begins, the alternation
+ *    of normal and friction solves of a small group (contact_forces.c, solve_with_friction, at most 8
+ *    rounds, each cutting the change by ~0.375 here) stops 1.5e-3 m/s^2 short, and the box slips
+ *    5.4e-7 m/s, the same without the reuse; the warm start then takes that out by e^-1 per step, so
+ *    10 steps later the bound is 1e-9 m/s (5.4e-7 e^-10 = 2.5e-11);
+ *  - a body removed and another added (same row count, same row) after a step: the new box, mid-air
+ *    at rest, falls freely in its first step: y = y0 - g dt^2/2 exactly up to round-off (RK4 is exact
+ *    for constant acceleration; 1e-12 m). The old box's floor touches on its row would hold it up;
+ *  - a pose set after a step: the box lifted 1 m falls freely, as above. */
+#include "check.h"
+#include "scenes.h"
+
+#define G 9.81
+#define DT (1.0 / 60.0)
+
+static lc_vec2 v2(double x, double y)
+{
+    lc_vec2 r;
+    r.x = x;
+    r.y = y;
+    return r;
+}
+
+static lc_world *resting_box(lc_body_id *box)
+{
+    lc_world_def d = lc_default_world_def();
+    lc_world *w;
+    d.gravity = v2(0.0, -G);
+    w = sc_world(&d);
+    if (!w) return NULL;
+    /* the floor has friction 1, the box 0: the pair's is their geometric mean, 0 until the box's is set */
+    CHECK(lc_body_set_material(w, sc_static_box(w, 20.0, 1.0, 0.0, -0.5, 0.0), 0.0, 1.0) == LC_OK, "%s",
+          lc_world_last_error(w));
+    *box = sc_box(w, 1.0, 0.5, 0.0, 0.25, 0.0, 0, 0, 0, 1.0, 0.0);
+    sc_step_n(w, DT, 30);   /* settled: the faces held at the contact gap */
+    return w;
+}
+
+static void reuse_happens(void)
+{
+    lc_body_id box;
+    lc_world *w = resting_box(&box);
+    lc_counters last;
+    if (!w) return;
+    sc_step_n(w, DT, 1);
+    lc_world_get_counters(w, &last, NULL);
+    CHECK(last.brute_force_steps == 2, "a resting step ran %llu whole-world broadphases (2 expected: trial, projection)",
+          (unsigned long long)last.brute_force_steps);
+    CHECK(last.collisions == 0 && last.contact_solves > 0, "%s", "the box rests on the floor");
+    lc_world_destroy(w);
+}
+
+static void friction_counts_at_once(void)
+{
+    lc_body_id box;
+    lc_world *w = resting_box(&box);
+    lc_vec2 push = {2.0, 0.0};
+    if (!w) return;
+    CHECK(lc_body_set_material(w, box, 0.0, 1.0) == LC_OK, "%s", lc_world_last_error(w));
+    CHECK(lc_body_set_external(w, box, push, 0.0) == LC_OK, "%s", lc_world_last_error(w));
+    sc_step_n(w, DT, 1);
+    CHECK_NEAR(sc_row(w, box)[3], 0.0, 1e-6, "vx of a box that static friction holds");
+    sc_step_n(w, DT, 10);
+    CHECK_NEAR(sc_row(w, box)[3], 0.0, 1e-9, "vx after 10 more steps");
+    lc_world_destroy(w);
+}
+
+static void free_fall_step(lc_world *w, lc_body_id id, const char *what)
+{
+    double y0 = sc_row(w, id)[1];
+    sc_step_n(w, DT, 1);
+    CHECK_NEAR(sc_row(w, id)[1], y0 - 0.5 * G * DT * DT, 1e-12, what);
+    CHECK_NEAR(sc_row(w, id)[4], -G * DT, 1e-12, what);
+}
+
+static void new_body_in_the_row(void)
+{
+    lc_body_id box, other;
+    lc_world *w = resting_box(&box);
+    if (!w) return;
+    CHECK(lc_world_remove_body(w, box) == LC_OK, "%s", lc_world_last_error(w));
+    other = sc_box(w, 1.0, 0.5, 3.0, 5.0, 0.0, 0, 0, 0, 1.0, 0.0);
+    CHECK(lc_world_body_index(w, other) == 1, "%s", "the new box takes the removed box's row");
+    free_fall_step(w, other, "a new box mid-air falls freely");
+    lc_world_destroy(w);
+}
+
+static void pose_set_after_a_step(void)
+{
+    lc_body_id box;
+    lc_world *w = resting_box(&box);
+    lc_vec2 up = {0.0, 1.25};
+    if (!w) return;
+    CHECK(lc_body_set_pose(w, box, up, 0.0) == LC_OK, "%s", lc_world_last_error(w));
+    CHECK(lc_body_set_velocity(w, box, v2(0.0, 0.0), 0.0) == LC_OK, "%s", lc_world_last_error(w));
+    free_fall_step(w, box, "a lifted box falls freely");
+    lc_world_destroy(w);
+}
+
+int main(void)
+{
+    reuse_happens();
+    friction_counts_at_once();
+    new_body_in_the_row();
+    pose_set_after_a_step();
+    return CHECK_SUMMARY("test_end_touches");
+}
