@@ -58,8 +58,9 @@ typedef struct lc_lcp_options {
     /* Fields below were added after the first interface; zero means "default". */
     double relaxation;     /* SOR factor w in (0, 2); 0 = default 1.0 (plain projected Gauss-Seidel). */
     int warm_start;        /* 1: the iterative method starts from the f passed in (projected onto the
-                              bounds; non-finite entries -> 0); 0 (default): from f = 0 (or from the
-                              exact iterate when the exact method fell back). Ignored by the exact method. */
+                              bounds; non-finite entries -> 0), and the exact method (lc_lcp_solve) from
+                              the active set {i : f_i > 0} of the f passed in, if any is; 0 (default):
+                              from f = 0, the exact method from {i : b_i < 0}. */
 } lc_lcp_options;
 
 /* The defaults listed above. */

@@ -7,11 +7,11 @@
  *    it was 3 before the reuse);
  *  - friction set after a step counts at once: a resting box with mu 0 -> 1 under a 2 N push stays
  *    put (static friction can give up to 9.81 N). With the old touches (mu 0) it would reach 2/60 m/s
- *    = 3.3e-2 m/s in the first step. Bound 1e-6 m/s in that step: when a push begins, the alternation
- *    of normal and friction solves of a small group (contact_forces.c, solve_with_friction, at most 8
- *    rounds, each cutting the change by ~0.375 here) stops 1.5e-3 m/s^2 short, and the box slips
- *    5.4e-7 m/s, the same without the reuse; the warm start then takes that out by e^-1 per step, so
- *    10 steps later the bound is 1e-9 m/s (5.4e-7 e^-10 = 2.5e-11);
+ *    = 3.3e-2 m/s in the first step. Bound 1e-9 m/s: the small groups' force tolerance is 9e-11
+ *    m/s^2 (contact_forces.c), 1.5e-12 m/s over a step. This also checks the friction alternation's
+ *    extrapolation (solve_with_friction): when the push begins, each round of normal and friction
+ *    solves cuts the change only by ~0.375, and the 8 rounds without it left the box slipping
+ *    5.4e-7 m/s in the first step;
  *  - a body removed and another added (same row count, same row) after a step: the new box, mid-air
  *    at rest, falls freely in its first step: y = y0 - g dt^2/2 exactly up to round-off (RK4 is exact
  *    for constant acceleration; 1e-12 m). The old box's floor touches on its row would hold it up;
@@ -68,7 +68,7 @@ static void friction_counts_at_once(void)
     CHECK(lc_body_set_material(w, box, 0.0, 1.0) == LC_OK, "%s", lc_world_last_error(w));
     CHECK(lc_body_set_external(w, box, push, 0.0) == LC_OK, "%s", lc_world_last_error(w));
     sc_step_n(w, DT, 1);
-    CHECK_NEAR(sc_row(w, box)[3], 0.0, 1e-6, "vx of a box that static friction holds");
+    CHECK_NEAR(sc_row(w, box)[3], 0.0, 1e-9, "vx of a box that static friction holds");
     sc_step_n(w, DT, 10);
     CHECK_NEAR(sc_row(w, box)[3], 0.0, 1e-9, "vx after 10 more steps");
     lc_world_destroy(w);

@@ -657,6 +657,29 @@ static void test_stack(lc_lcp_workspace *ws)
     memcpy(fi, fx, sizeof fi);
     lc_lcp_solve(NSTACK, A, b, fi, a, &oi, ws, &r);
     CHECK(r.status == 0 && r.sweeps <= 1, "stack warm start: status %d sweeps %d", r.status, r.sweeps);
+
+    /* the exact method warm-started from its own answer: the block solve alone (1 pivot, where the
+     * start from {b < 0} pivoted more) and the same forces to rounding (1e-10 N as above); from a
+     * wrong guess (every row active but the first, so a row must come back in) the same forces too */
+    {
+        lc_lcp_options ow = lc_lcp_default_options();
+        int cold;
+        int k;
+        lc_lcp_solve(NSTACK, A, b, fi, a, &oe, ws, &r);
+        cold = r.pivots;
+        ow.warm_start = 1;
+        memcpy(fi, fx, sizeof fi);
+        lc_lcp_solve(NSTACK, A, b, fi, a, &ow, ws, &r);
+        err = max_abs_diff(NSTACK, fi, fexp);
+        CHECK(r.status == 0 && r.exact == 1 && r.pivots == 1 && cold > 1,
+              "stack exact warm: status %d pivots %d (cold %d)", r.status, r.pivots, cold);
+        CHECK(err < 1e-10, "stack exact warm vs closed form: %g N", err);
+        for (k = 0; k < NSTACK; ++k) fi[k] = k == 0 ? 0.0 : 1.0 + k;
+        lc_lcp_solve(NSTACK, A, b, fi, a, &ow, ws, &r);
+        err = max_abs_diff(NSTACK, fi, fexp);
+        CHECK(r.status == 0 && r.exact == 1 && err < 1e-10, "stack exact from a wrong guess: status %d error %g N",
+              r.status, err);
+    }
 }
 
 /* ---------------------------------------------------------------------------------------------
