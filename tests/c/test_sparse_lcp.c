@@ -17,6 +17,7 @@
 #include "lcp.h"
 #include "scenes.h"
 #include "world.h"
+#include "white_box.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -38,19 +39,6 @@ static lc_world *brick_wall(void)
         for (j = 0; j < PER_ROW - i; ++j)
             sc_box(w, 1.0, 1.0, 0.5 * i + j - 0.5 * PER_ROW, 0.5 + i, 0.0, 0, 0, 0, 1.0 + 0.5 * j, 0.0);
     return w;
-}
-
-/* every touch of the wall (gap < contact_distance) */
-static int wall_touches(lc_world *w, lc_buf *buf)
-{
-    int a, b, n = 0;
-    for (a = 0; a < w->count; ++a)
-        for (b = a + 1; b < w->count; ++b) {
-            n = lc_collect_touches(w, w->state, a, b, w->def.contact_distance, buf, n);
-            CHECK(n >= 0, "lc_collect_touches failed");
-            if (n < 0) return 0;
-        }
-    return n;
 }
 
 /* Complementarity of x with y = A x + b within bounds, to tol; returns the worst violation. */
@@ -93,7 +81,7 @@ int main(void)
     sc_rng rng;
     rng.s = 7;
     if (!w) return CHECK_SUMMARY("test_sparse_lcp");
-    m = wall_touches(w, &buf);
+    m = wb_all_touches(w, &buf);
     t = (lc_touch *)buf.p;
     /* 14 boxes: 5 on the floor (2 corners each), 13 box-on-box faces (2 points each), side faces */
     CHECK(m >= 30, "the wall has %d touches (expected the floor, stacked and side faces)", m);

@@ -19,22 +19,10 @@
 #include "check.h"
 #include "scenes.h"
 #include "world.h"
+#include "white_box.h"
 
 #include <math.h>
 #include <stdlib.h>
-
-/* every touch between two bodies of the world (gap < contact_distance) */
-static int all_touches(lc_world *w, lc_buf *buf)
-{
-    int a, b, n = 0;
-    for (a = 0; a < w->count; ++a)
-        for (b = a + 1; b < w->count; ++b) {
-            n = lc_collect_touches(w, w->state, a, b, w->def.contact_distance, buf, n);
-            CHECK(n >= 0, "lc_collect_touches failed");
-            if (n < 0) return 0;
-        }
-    return n;
-}
 
 /* Sum of the guess's parts along up over the touches that hold up row `held` (its normal points up into
  * it); left/right: only those whose point lies left/right of x_split (NULL: every one). */
@@ -74,7 +62,7 @@ static void column_forces(void)
     double *f;
     int n, k;
     if (!w) return;
-    n = all_touches(w, &buf);
+    n = wb_all_touches(w, &buf);
     f = calloc((size_t)(n > 0 ? n : 1), sizeof *f);
     CHECK(f != NULL && n >= 6, "the column has %d touches (floor and two faces, two corners each)", n);
     if (f && n >= 6) {
@@ -104,7 +92,7 @@ static void lever_rule(void)
     sc_static_box(w, 10.0, 1.0, 0.0, -0.5, 0.0);
     sc_box(w, 1.0, 1.0, 0.0, 0.5, 0.0, 0, 0, 0, 1.0, 0.0);     /* row 1 */
     sc_box(w, 0.5, 0.5, 0.25, 1.25, 0.0, 0, 0, 0, 1.0, 0.0);   /* row 2: spans x 0 .. 0.5 on row 1's top */
-    n = all_touches(w, &buf);
+    n = wb_all_touches(w, &buf);
     f = calloc((size_t)(n > 0 ? n : 1), sizeof *f);
     CHECK(f != NULL && n >= 4, "%d touches", n);
     if (f && n >= 4) {
@@ -125,7 +113,7 @@ static void no_gravity(void)
     double *f;
     int n, i, nonzero = 0;
     if (!w) return;
-    n = all_touches(w, &buf);
+    n = wb_all_touches(w, &buf);
     f = calloc((size_t)(n > 0 ? n : 1), sizeof *f);
     CHECK(f != NULL && n >= 6, "%d touches", n);
     if (f && n >= 6) {
@@ -146,7 +134,7 @@ static void column_lifts(void)
     lc_touch *t;
     int n, i, k;
     if (!w) return;
-    n = all_touches(w, &buf);
+    n = wb_all_touches(w, &buf);
     t = (lc_touch *)buf.p;
     lam = calloc((size_t)(n > 0 ? n : 1), sizeof *lam);
     deficit = calloc((size_t)(n > 0 ? n : 1), sizeof *deficit);
