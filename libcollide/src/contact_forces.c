@@ -130,7 +130,8 @@ static int solve_with_friction(lc_world *w, const double *state, lc_touch *sub, 
         cross_response(w, sub, m, 1, fold, 0, body, moved);
         for (i = 0; i < m; ++i) change = fmax(change, fabs(moved[i]));
         if (change <= tol) break;
-        if (prev_change > 0.0 && change < prev_change) {
+        /* never in the last round: its forces would leave without a solve that checks them */
+        if (prev_change > 0.0 && change < prev_change && outer + 1 < LC_FRICTION_ROUNDS_SMALL) {
             double rho = change / prev_change;
             if (rho < 0.95 && fabs(rho - prev_rho) <= 0.1 * rho) {
                 double to_limit = rho / (1.0 - rho);
