@@ -66,6 +66,15 @@ static int add_pair(lc_buf *buf, int count, int a, int b)
     return count + 1;
 }
 
+/* A candidate pair when the two boxes overlap and not both bodies are static: count + 1, else count
+ * (-1: no memory). */
+static int add_if_near(const lc_world *w, lc_buf *buf, int count, const box *x, const box *y)
+{
+    if (w->is_static[x->row] && w->is_static[y->row]) return count;
+    if (!overlap(x, y)) return count;
+    return add_pair(buf, count, x->row, y->row);
+}
+
 static int cmp_box(const void *x, const void *y)
 {
     const box *a = x, *b = y;
@@ -114,23 +123,14 @@ int lc_broad_phase(lc_world *w, const double *s0, const double *s1, double margi
     if (!use_sweep) {
         w->last.brute_force_steps++;
         for (i = 0; i < n; ++i)
-            for (j = i + 1; j < n; ++j) {
-                if (w->is_static[i] && w->is_static[j]) continue;
-                if (!overlap(&boxes[i], &boxes[j])) continue;
-                count = add_pair(buf, count, i, j);
-                if (count < 0) return -1;
-            }
+            for (j = i + 1; j < n; ++j)
+                if ((count = add_if_near(w, buf, count, &boxes[i], &boxes[j])) < 0) return -1;
     } else {
         w->last.sort_and_sweep_steps++;
         qsort(boxes, (size_t)n, sizeof(box), cmp_box);
         for (i = 0; i < n; ++i)
-            for (j = i + 1; j < n && boxes[j].x0 <= boxes[i].x1; ++j) {
-                int a = boxes[i].row, b = boxes[j].row;
-                if (w->is_static[a] && w->is_static[b]) continue;
-                if (!overlap(&boxes[i], &boxes[j])) continue;
-                count = add_pair(buf, count, a, b);
-                if (count < 0) return -1;
-            }
+            for (j = i + 1; j < n && boxes[j].x0 <= boxes[i].x1; ++j)
+                if ((count = add_if_near(w, buf, count, &boxes[i], &boxes[j])) < 0) return -1;
         /* same pair order as brute force, so results do not depend on the broadphase */
         if (count > 1) qsort(buf->p, (size_t)count, 2 * sizeof(int), cmp_pair);
     }
@@ -155,21 +155,12 @@ int lc_broad_phase_of(lc_world *w, const double *s0, const double *s1, double ma
     /* neither brute force nor sort-and-sweep over the world: not counted as either */
     for (a = 0; a < n; ++a) {
         if (marked[a]) {
-            for (b = a + 1; b < n; ++b) {
-                if (w->is_static[a] && w->is_static[b]) continue;
-                if (!overlap(&boxes[a], &boxes[b])) continue;
-                count = add_pair(buf, count, a, b);
-                if (count < 0) return -1;
-            }
+            for (b = a + 1; b < n; ++b)
+                if ((count = add_if_near(w, buf, count, &boxes[a], &boxes[b])) < 0) return -1;
         } else {
             while (first < nlist && sorted[first] <= a) ++first;
-            for (k = first; k < nlist; ++k) {
-                b = sorted[k];
-                if (w->is_static[a] && w->is_static[b]) continue;
-                if (!overlap(&boxes[a], &boxes[b])) continue;
-                count = add_pair(buf, count, a, b);
-                if (count < 0) return -1;
-            }
+            for (k = first; k < nlist; ++k)
+                if ((count = add_if_near(w, buf, count, &boxes[a], &boxes[sorted[k]])) < 0) return -1;
         }
     }
     w->last.broadphase_pairs += (uint64_t)count;

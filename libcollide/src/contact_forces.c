@@ -41,25 +41,6 @@ static double tangential_velocity(const double *state, const lc_touch *t)
     return lc_dot(lc_tangent_of(t->n), lc_sub(va, vb));
 }
 
-/* out[i] = sum_j A(row i, row j) x[j] between the normal (tangent = 0) or tangent rows of x and of out,
- * through the bodies' responses: each row's push spread onto its two bodies, then read back along
- * every out row, O(m) where the dense block is O(m^2). body: scratch of count x 3 doubles, of which
- * only the group's bodies are cleared and used. */
-static void cross_response(const lc_world *w, const lc_touch *t, int m, int from_tangent, const double *x,
-                           int to_tangent, double *body, double *out)
-{
-    int i;
-    for (i = 0; i < m; ++i) {
-        memset(&body[t[i].a * 3], 0, 3 * sizeof(double));
-        memset(&body[t[i].b * 3], 0, 3 * sizeof(double));
-    }
-    for (i = 0; i < m; ++i)
-        if (x[i] != 0.0)
-            lc_touch_apply(w, &t[i], lc_scale(from_tangent ? lc_tangent_of(t[i].n) : t[i].n, x[i]), body, 3);
-    for (i = 0; i < m; ++i)
-        out[i] = lc_response_push(w, &t[i], to_tangent ? lc_tangent_of(t[i].n) : t[i].n, body);
-}
-
 /* Most alternations between the normal and the friction rows of a small group. */
 #define LC_FRICTION_ROUNDS_SMALL 8
 
@@ -104,12 +85,12 @@ static int solve_with_friction(lc_world *w, const double *state, lc_touch *sub, 
     for (outer = 0; outer < LC_FRICTION_ROUNDS_SMALL; ++outer) {
         double change = 0.0;
         int k;
-        cross_response(w, sub, m, 1, ft, 0, body, bn);
+        lc_response_rows(w, sub, m, 1, ft, 0, body, bn);
         for (i = 0; i < m; ++i) bn[i] += b_n[i];
         lc_lcp_solve(m, Ann, bn, fn, NULL, opt, w->lcp, &res);
         w->last.contact_solve_iterations += (uint64_t)res.iterations;
         for (i = 0; i < m; ++i) if (!(fn[i] > 0.0) || !isfinite(fn[i])) fn[i] = 0.0;
-        cross_response(w, sub, m, 0, fn, 1, body, bt);
+        lc_response_rows(w, sub, m, 0, fn, 1, body, bt);
         for (i = 0; i < m; ++i) {
             bt[i] += b_t[i];
             hi[i] = sub[i].friction * fn[i];
@@ -127,7 +108,7 @@ static int solve_with_friction(lc_world *w, const double *state, lc_touch *sub, 
         if (viol > res.residual) res.residual = viol;
         /* done when the new friction forces no longer change what the normal rows see */
         for (i = 0; i < m; ++i) fold[i] = ft[i] - fold[i];
-        cross_response(w, sub, m, 1, fold, 0, body, moved);
+        lc_response_rows(w, sub, m, 1, fold, 0, body, moved);
         for (i = 0; i < m; ++i) change = fmax(change, fabs(moved[i]));
         if (change <= tol) break;
         /* never in the last round: its forces would leave without a solve that checks them */
@@ -195,11 +176,9 @@ static int solve_large_group(lc_world *w, const double *state, lc_touch *sub, in
     for (round = 0; round < (with_friction ? LC_FRICTION_ROUNDS : 1); ++round) {
         double moved = 0.0;
         /* normal rows, the friction forces held */
-        memset(body, 0, (size_t)w->count * 3 * sizeof(double));
-        for (i = 0; i < m; ++i)
-            if (ft[i] != 0.0) lc_touch_apply(w, &sub[i], lc_scale(lc_tangent_of(sub[i].n), ft[i]), body, 3);
+        lc_response_rows(w, sub, m, 1, ft, 0, body, rhs);
         for (i = 0; i < m; ++i) {
-            rhs[i] = bn[i] + lc_response_push(w, &sub[i], sub[i].n, body);
+            rhs[i] += bn[i];
             lo[i] = 0.0;
             hi[i] = INFINITY;
         }
@@ -208,11 +187,9 @@ static int solve_large_group(lc_world *w, const double *state, lc_touch *sub, in
         products += k;
         if (!with_friction) break;
         /* tangent rows boxed by the cone of these normal forces, the normal forces held */
-        memset(body, 0, (size_t)w->count * 3 * sizeof(double));
-        for (i = 0; i < m; ++i)
-            if (fn[i] != 0.0) lc_touch_apply(w, &sub[i], lc_scale(sub[i].n, fn[i]), body, 3);
+        lc_response_rows(w, sub, m, 0, fn, 1, body, rhs);
         for (i = 0; i < m; ++i) {
-            rhs[i] = bt[i] + lc_response_push(w, &sub[i], lc_tangent_of(sub[i].n), body);
+            rhs[i] += bt[i];
             hi[i] = sub[i].friction * fn[i];
             lo[i] = -hi[i];
             ft_old[i] = ft[i];
@@ -220,12 +197,11 @@ static int solve_large_group(lc_world *w, const double *state, lc_touch *sub, in
         k = lc_sparse_lcp(w, sub, m, 1, rhs, lo, hi, ft, tol, budget, &tviol);
         if (k < 0) return -1;
         products += k;
-        /* how much the new friction forces change the normal rows' accelerations */
-        memset(body, 0, (size_t)w->count * 3 * sizeof(double));
-        for (i = 0; i < m; ++i)
-            if (ft[i] != ft_old[i])
-                lc_touch_apply(w, &sub[i], lc_scale(lc_tangent_of(sub[i].n), ft[i] - ft_old[i]), body, 3);
-        for (i = 0; i < m; ++i) moved = fmax(moved, fabs(lc_response_push(w, &sub[i], sub[i].n, body)));
+        /* how much the new friction forces change the normal rows' accelerations (ft_old: the change,
+         * rhs: its effect) */
+        for (i = 0; i < m; ++i) ft_old[i] = ft[i] - ft_old[i];
+        lc_response_rows(w, sub, m, 1, ft_old, 0, body, rhs);
+        for (i = 0; i < m; ++i) moved = fmax(moved, fabs(rhs[i]));
         if (moved <= tol) break;
         if (round + 1 == LC_FRICTION_ROUNDS) viol = fmax(viol, moved);
     }

@@ -104,33 +104,27 @@ static int solve_block_sparse(lc_world *w, double *state, lc_touch *t, int n, in
     }
     for (round = 0; round < (with_friction ? LC_IMPULSE_FRICTION_ROUNDS : 1); ++round) {
         double moved = 0.0;
-        memset(body, 0, (size_t)w->count * 3 * sizeof(double));
-        for (i = 0; i < n; ++i)
-            if (jt[i] != 0.0) lc_touch_apply(w, &t[i], lc_scale(lc_tangent_of(t[i].n), jt[i]), body, 3);
+        lc_response_rows(w, t, n, 1, jt, 0, body, rhs);
         for (i = 0; i < n; ++i) {
-            rhs[i] = vn0[i] + lc_response_push(w, &t[i], t[i].n, body);
+            rhs[i] += vn0[i];
             lo[i] = 0.0;
             hi[i] = INFINITY;
         }
         k = lc_sparse_lcp(w, t, n, 0, rhs, lo, hi, jn, tol, budget, &viol);
         if (k < 0) return -1;
         if (!with_friction) break;
-        memset(body, 0, (size_t)w->count * 3 * sizeof(double));
-        for (i = 0; i < n; ++i)
-            if (jn[i] != 0.0) lc_touch_apply(w, &t[i], lc_scale(t[i].n, jn[i]), body, 3);
+        lc_response_rows(w, t, n, 0, jn, 1, body, rhs);
         for (i = 0; i < n; ++i) {
-            rhs[i] = vt0[i] + lc_response_push(w, &t[i], lc_tangent_of(t[i].n), body);
+            rhs[i] += vt0[i];
             hi[i] = t[i].friction * jn[i];
             lo[i] = -hi[i];
             jt_old[i] = jt[i];
         }
         k = lc_sparse_lcp(w, t, n, 1, rhs, lo, hi, jt, tol, budget, &viol);
         if (k < 0) return -1;
-        memset(body, 0, (size_t)w->count * 3 * sizeof(double));
-        for (i = 0; i < n; ++i)
-            if (jt[i] != jt_old[i])
-                lc_touch_apply(w, &t[i], lc_scale(lc_tangent_of(t[i].n), jt[i] - jt_old[i]), body, 3);
-        for (i = 0; i < n; ++i) moved = fmax(moved, fabs(lc_response_push(w, &t[i], t[i].n, body)));
+        for (i = 0; i < n; ++i) jt_old[i] = jt[i] - jt_old[i];   /* the change, and in rhs its effect */
+        lc_response_rows(w, t, n, 1, jt_old, 0, body, rhs);
+        for (i = 0; i < n; ++i) moved = fmax(moved, fabs(rhs[i]));
         if (moved <= tol) break;
     }
     w->last.impulse_solves++;

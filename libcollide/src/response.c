@@ -2,6 +2,7 @@
  * relative velocity along one direction at one touch per unit impulse along another at another),
  * and applying an equal and opposite push to the two bodies of a touch. Shared by impacts, resting
  * contact forces and the position projection, which differ only in what is pushed. */
+#include <string.h>
 #include "world.h"
 
 double lc_response_dir(const lc_world *w, const lc_touch *ti, lc_vec2 di, const lc_touch *tj, lc_vec2 dj)
@@ -63,4 +64,23 @@ double lc_response_push(const lc_world *w, const lc_touch *t, lc_vec2 d, const d
         v -= lc_dot(d, lc_add(lc_v(x[0], x[1]), lc_wcross(x[2], t->rb)));
     }
     return v;
+}
+
+void lc_response_rows(const lc_world *w, const lc_touch *t, int m, int from_tangent, const double *x,
+                      int to_tangent, double *body, double *out)
+{
+    int i;
+    /* only the touches' bodies are written and read: a small group in a large world clears just those */
+    if (2 * m < w->count) {
+        for (i = 0; i < m; ++i) {
+            memset(&body[t[i].a * 3], 0, 3 * sizeof(double));
+            memset(&body[t[i].b * 3], 0, 3 * sizeof(double));
+        }
+    } else {
+        memset(body, 0, (size_t)w->count * 3 * sizeof(double));
+    }
+    for (i = 0; i < m; ++i)
+        if (x[i] != 0.0)
+            lc_touch_apply(w, &t[i], lc_scale(from_tangent ? lc_tangent_of(t[i].n) : t[i].n, x[i]), body, 3);
+    for (i = 0; i < m; ++i) out[i] = lc_response_push(w, &t[i], to_tangent ? lc_tangent_of(t[i].n) : t[i].n, body);
 }

@@ -33,17 +33,6 @@ static lc_vec2 row_dir(const lc_touch *t, int tangent)
     return tangent ? lc_tangent_of(t->n) : t->n;
 }
 
-/* y = A x, through the bodies' responses (body: scratch of count*3 doubles) */
-static void apply_response(const lc_world *w, const lc_touch *t, int m, int tangent, const double *x, double *body,
-                           double *y)
-{
-    int i;
-    memset(body, 0, (size_t)w->count * 3 * sizeof(double));
-    for (i = 0; i < m; ++i)
-        if (x[i] != 0.0) lc_touch_apply(w, &t[i], lc_scale(row_dir(&t[i], tangent), x[i]), body, 3);
-    for (i = 0; i < m; ++i) y[i] = lc_response_push(w, &t[i], row_dir(&t[i], tangent), body);
-}
-
 static double dot(const double *x, const double *y, int m)
 {
     double s = 0.0;
@@ -64,7 +53,7 @@ static double norm_estimate(const lc_world *w, const lc_touch *t, int m, int tan
         nv = sqrt(dot(v, v, m));
         if (!(nv > 0.0)) break;
         for (i = 0; i < m; ++i) v[i] /= nv;
-        apply_response(w, t, m, tangent, v, body, av);
+        lc_response_rows(w, t, m, tangent, v, tangent, body, av);
         lambda = dot(v, av, m);
         memcpy(v, av, (size_t)m * sizeof(double));
     }
@@ -169,7 +158,7 @@ int lc_sparse_lcp(lc_world *w, const lc_touch *t, int m, int tangent, const doub
         if (!isfinite(x[i])) x[i] = 0.0;
         x[i] = fmin(fmax(x[i], lo[i]), hi[i]);
     }
-    apply_response(w, t, m, tangent, x, body, g);
+    lc_response_rows(w, t, m, tangent, x, tangent, body, g);
     products++;
     for (i = 0; i < m; ++i) g[i] += b[i];
     worst = gradients(x, g, lo, hi, m, alpha, phi, beta, &bb, &pp);
@@ -177,7 +166,7 @@ int lc_sparse_lcp(lc_world *w, const lc_touch *t, int m, int tangent, const doub
     while (worst > tol && products < max_products) {
         if (bb <= LC_MPRGP_GAMMA * LC_MPRGP_GAMMA * pp) {
             double pap, acg, af;
-            apply_response(w, t, m, tangent, p, body, ap);
+            lc_response_rows(w, t, m, tangent, p, tangent, body, ap);
             products++;
             pap = dot(p, ap, m);
             if (!(pap > 0.0)) {
@@ -218,7 +207,7 @@ int lc_sparse_lcp(lc_world *w, const lc_touch *t, int m, int tangent, const doub
                 }
                 worst = gradients(x, g, lo, hi, m, alpha, phi, beta, &bb, &pp);
                 for (i = 0; i < m; ++i) x[i] = clamp(x[i] - alpha * phi[i], lo[i], hi[i]);
-                apply_response(w, t, m, tangent, x, body, g);
+                lc_response_rows(w, t, m, tangent, x, tangent, body, g);
                 products++;
                 for (i = 0; i < m; ++i) g[i] += b[i];
                 worst = gradients(x, g, lo, hi, m, alpha, phi, beta, &bb, &pp);
@@ -228,7 +217,7 @@ int lc_sparse_lcp(lc_world *w, const lc_touch *t, int m, int tangent, const doub
             /* proportioning: move the rows that their bound holds against their gradient */
             double dad, step, cap;
             memcpy(d, beta, (size_t)m * sizeof(double));
-            apply_response(w, t, m, tangent, d, body, ap);
+            lc_response_rows(w, t, m, tangent, d, tangent, body, ap);
             products++;
             dad = dot(d, ap, m);
             if (!(dad > 0.0)) break;

@@ -200,6 +200,11 @@ void lc_touch_apply(const lc_world *w, const lc_touch *t, lc_vec2 push, double *
 /* Relative motion along d at touch t produced by per-body changes acc[row * 3 + 0..2] (the inverse of
  * lc_touch_apply with stride 3). */
 double lc_response_push(const lc_world *w, const lc_touch *t, lc_vec2 d, const double *acc);
+/* out = A x between rows of t[0..m): x pushes along each touch's normal (from_tangent = 0) or tangent,
+ * out is read back along the normal (to_tangent = 0) or tangent; A is never formed, O(m + bodies).
+ * body: scratch of count x 3 doubles (overwritten). */
+void lc_response_rows(const lc_world *w, const lc_touch *t, int m, int from_tangent, const double *x,
+                      int to_tangent, double *body, double *out);
 /* Tangent of a contact normal (the direction of friction rows and tangent impulses). */
 static inline lc_vec2 lc_tangent_of(lc_vec2 n) { return lc_v(-n.y, n.x); }
 
@@ -213,7 +218,7 @@ int lc_sparse_lcp(lc_world *w, const lc_touch *t, int m, int tangent, const doub
 /* ---- static_load.c ---- */
 /* Starting guesses for a cold pile's sparse solves (only touches a body rests on get one; f, lam must
  * hold zeros). Each returns 0 (no gravity: no guess), or -1 on allocation failure. */
-/* f[i]: N, the weight each touch carries when loads are shared equally among a body's supports. */
+/* f[i]: N, the weight each touch carries when loads are shared among a body's supports by the lever rule. */
 int lc_static_load_forces(lc_world *w, const lc_touch *t, int m, double *f);
 /* lam[i]: kg*m, the projection's multipliers that lift every body by the gaps below it (deficit[i], m,
  * what touch i is short of the contact gap). */
