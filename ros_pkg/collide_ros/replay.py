@@ -155,7 +155,8 @@ def compare(recorded: list[States], replayed: dict[int, States]) -> dict[str, An
 class Replayer:
     """In-process ROS side: publishers for the commands, echo and state subscriptions, ~/step."""
 
-    def __init__(self, node_name: str = "sim", cmd_vel_stamped: bool = False) -> None:
+    def __init__(self, node_name: str = "sim", cmd_vel_stamped: bool = False,
+                 time_step: float = 0.001) -> None:
         import rclpy
         from libcollide_msgs.msg import BodyStates
         from libcollide_msgs.srv import Step
@@ -176,6 +177,7 @@ class Replayer:
         self._step_cls = Step
         self.steps = 0
         self.sim_time = 0.0
+        self.time_step = time_step
 
     def _on_states(self, raw: bytes) -> None:
         from rclpy.serialization import deserialize_message
@@ -225,18 +227,49 @@ class Replayer:
         while time.monotonic() < end:
             self.rclpy.spin_once(self.node, timeout_sec=0.01)
 
+    def _call_step(self, k: int, timeout: float) -> Any:
+        """One ~/step call; None when no answer came within `timeout` s."""
+        req = self._step_cls.Request()
+        req.steps = k
+        fut = self.step_cli.call_async(req)
+        self.rclpy.spin_until_future_complete(self.node, fut, timeout_sec=timeout)
+        return fut.result() if fut.done() else None
+
+    def handshake(self, timeout: float, attempt: float = 2.0) -> Any:
+        """Call ~/step with 0 steps until an answer comes back; returns it (None on timeout).
+
+        `service_is_ready()` shows only that requests reach the node. The answer travels on a
+        second DDS topic whose two ends match on their own schedule, and an answer sent before
+        they have matched is dropped (rmw_fastrtps waits 100 ms, then gives up; a loaded CI
+        machine lost the first ~/step answer of a replay that way). A zero-step call changes
+        nothing, so it can be repeated until one answer proves the way back."""
+        end = time.monotonic() + timeout
+        while time.monotonic() < end:
+            res = self._call_step(0, min(attempt, max(end - time.monotonic(), 0.01)))
+            if res is not None:
+                return res
+        return None
+
     def step(self, n: int, chunk: int = 50, timeout: float = 30.0) -> None:
         """Advance the paused node by n steps (in chunks, draining states in between)."""
         while n > 0:
             k = min(n, chunk)
-            req = self._step_cls.Request()
-            req.steps = k
-            fut = self.step_cli.call_async(req)
-            self.rclpy.spin_until_future_complete(self.node, fut, timeout_sec=timeout)
-            res = fut.result()
-            if res is None or not res.success:
-                why = "timeout" if res is None else res.message
-                raise RuntimeError(f"~/step {k} failed: {why}")
+            res = self._call_step(k, timeout)
+            if res is None:
+                # the answer may be lost rather than late: ask where the node is, via zero-step
+                # calls, before deciding whether these k steps happened
+                probe = self.handshake(timeout)
+                if probe is None:
+                    raise RuntimeError(f"~/step {k} failed: timeout, and the node answers no zero-step call")
+                t = probe.sim_time.sec + 1e-9 * probe.sim_time.nanosec
+                moved = round((t - self.sim_time) / self.time_step)
+                if moved == 0:
+                    continue  # the request was lost: send it again
+                if moved != k:
+                    raise RuntimeError(f"~/step {k}: the answer was lost and the node moved {moved} steps")
+                res = probe
+            elif not res.success:
+                raise RuntimeError(f"~/step {k} failed: {res.message}")
             self.sim_time = res.sim_time.sec + 1e-9 * res.sim_time.nanosec
             self.steps += k
             n -= k
@@ -292,11 +325,15 @@ def replay(bag: str | Path, node_cmd: list[str] | None = None, env: dict[str, st
         pf = params_file(params, Path(tmp) / "params.yaml")
         proc = subprocess.Popen(node_cmd + ["--ros-args", "--params-file", str(pf)], env=env,
                                 stdout=log or subprocess.DEVNULL, stderr=subprocess.STDOUT)
-        rep = Replayer(cmd_vel_stamped=bool(params.get("cmd_vel_stamped", False)))
+        rep = Replayer(cmd_vel_stamped=bool(params.get("cmd_vel_stamped", False)), time_step=dt)
         try:
             rep.prepare(cmds)
             if not rep.wait_ready(60.0):
                 raise RuntimeError("fresh node did not come up (step service / topics)")
+            first = rep.handshake(60.0)
+            if first is None:
+                raise RuntimeError("fresh node's ~/step never answered a zero-step call")
+            rep.sim_time = first.sim_time.sec + 1e-9 * first.sim_time.nanosec
             for i, c in enumerate(cmds):
                 k = round(c.stamp * 1e-9 / dt) + (1 if i == delay_command else 0)
                 if k < rep.steps:
