@@ -84,6 +84,30 @@ static int solve_block_friction(lc_world *w, double *state, lc_touch *t, int n, 
  * |j_t| <= mu j_n) alternated with the normal ones, then (1 + e) times the normal ones. Converged when
  * no point is left approaching faster than a thousandth of resting_speed, well inside what the
  * resting test treats as at rest. */
+/* The normal rows of a large impact with the friction impulses jt held: jn (warm start and answer)
+ * from MPRGP; rhs, lo, hi: scratch of n. Returns products of A used, or -1. */
+static int normal_impulses(lc_world *w, const lc_touch *t, int n, const double *jt, const double *vn0, double *body,
+                           double *rhs, double *lo, double *hi, double *jn, double tol, int budget, double *viol)
+{
+    int i;
+    lc_response_rows(w, t, n, 1, jt, 0, body, rhs);
+    for (i = 0; i < n; ++i) {
+        rhs[i] += vn0[i];
+        lo[i] = 0.0;
+        hi[i] = INFINITY;
+    }
+    return lc_sparse_lcp(w, t, n, 0, rhs, lo, hi, jn, tol, budget, viol);
+}
+
+static void clip_to_cone(const lc_touch *t, int n, const double *jn, double *jt)
+{
+    int i;
+    for (i = 0; i < n; ++i) {
+        double c = t[i].friction * jn[i];
+        jt[i] = jt[i] > c ? c : jt[i] < -c ? -c : jt[i];
+    }
+}
+
 static int solve_block_sparse(lc_world *w, double *state, lc_touch *t, int n, int restitute)
 {
     double *v = lc_buf_get(&w->b_fric, (size_t)n * 8 * sizeof(double));
@@ -104,14 +128,7 @@ static int solve_block_sparse(lc_world *w, double *state, lc_touch *t, int n, in
     }
     for (round = 0; round < (with_friction ? LC_IMPULSE_FRICTION_ROUNDS : 1); ++round) {
         double moved = 0.0;
-        lc_response_rows(w, t, n, 1, jt, 0, body, rhs);
-        for (i = 0; i < n; ++i) {
-            rhs[i] += vn0[i];
-            lo[i] = 0.0;
-            hi[i] = INFINITY;
-        }
-        k = lc_sparse_lcp(w, t, n, 0, rhs, lo, hi, jn, tol, budget, &viol);
-        if (k < 0) return -1;
+        if (normal_impulses(w, t, n, jt, vn0, body, rhs, lo, hi, jn, tol, budget, &viol) < 0) return -1;
         if (!with_friction) break;
         lc_response_rows(w, t, n, 0, jn, 1, body, rhs);
         for (i = 0; i < n; ++i) {
@@ -134,22 +151,9 @@ static int solve_block_sparse(lc_world *w, double *state, lc_touch *t, int n, in
              * instant: a 5 kg box at 8 m/s into a frictional 78-box pyramid made 67 impacts in its
              * step, 38 with this. The last clip, to the cone of the final normal impulses, leaves a
              * far smaller approach. */
-            for (i = 0; i < n; ++i) {
-                double c = t[i].friction * jn[i];
-                jt[i] = jt[i] > c ? c : jt[i] < -c ? -c : jt[i];
-            }
-            lc_response_rows(w, t, n, 1, jt, 0, body, rhs);
-            for (i = 0; i < n; ++i) {
-                rhs[i] += vn0[i];
-                lo[i] = 0.0;
-                hi[i] = INFINITY;
-            }
-            k = lc_sparse_lcp(w, t, n, 0, rhs, lo, hi, jn, tol, budget, &viol);
-            if (k < 0) return -1;
-            for (i = 0; i < n; ++i) {
-                double c = t[i].friction * jn[i];
-                jt[i] = jt[i] > c ? c : jt[i] < -c ? -c : jt[i];
-            }
+            clip_to_cone(t, n, jn, jt);
+            if (normal_impulses(w, t, n, jt, vn0, body, rhs, lo, hi, jn, tol, budget, &viol) < 0) return -1;
+            clip_to_cone(t, n, jn, jt);
         }
     }
     w->last.impulse_solves++;
