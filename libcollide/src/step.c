@@ -739,9 +739,11 @@ static int keep_clean_crossings(lc_world *w, const uint8_t *dirty, double tmin)
 
 /* Crossings by estimated time (where the straight path crossed within the tested interval), ties by
  * index. A crossing is searched only if it has reached the gap by the earliest time found so far, so
- * the order leaves the answer as it is; but in a pile hit from above, where a pass can hold 150
- * crossings in one island and each search re-integrates the whole pile, earliest first makes it
- * about one full search a pass instead of one per new earliest. */
+ * the order changes which crossings are searched, not the earliest time (up to the search tolerance
+ * and the choice among exact ties). In a pile hit from above a pass can hold 150 crossings in one
+ * island, each search re-integrating the whole pile: earliest first took the step of the impact in
+ * bench/repro/drop_into_pyramid.py from 196 searches to 134 (the estimate is rough there: paths under
+ * contact forces are not straight). */
 typedef struct crossing_key { double t; int i; } crossing_key;
 
 static int by_estimated_time(const void *x, const void *y)
