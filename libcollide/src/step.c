@@ -541,10 +541,7 @@ static int swept_check(lc_world *w, const double *s0, const double *s1, double h
             nc = lc_find_crossings(w, prev, cur, a, b, &w->b_cross, nc);
             if (nc < 0) return -1;
             if (nc > before) {
-                for (i = before; i < nc; ++i) {
-                    ((lc_crossing *)w->b_cross.p)[i].t_lo = h * (k - 1) / LC_SWEEP_SAMPLES;
-                    ((lc_crossing *)w->b_cross.p)[i].t_hi = tk;
-                }
+                for (i = before; i < nc; ++i) ((lc_crossing *)w->b_cross.p)[i].t_hi = tk;
                 break;
             }
             prev = cur;
@@ -730,42 +727,10 @@ static int keep_clean_crossings(lc_world *w, const uint8_t *dirty, double tmin)
     for (i = 0; i < nc; ++i) {
         if (dirty[c[i].a] || dirty[c[i].b]) continue;
         c[i].t_hi -= tmin;
-        c[i].t_lo = c[i].t_lo > tmin ? c[i].t_lo - tmin : 0.0;
         if (!(c[i].t_hi > 0.0)) continue;
         c[kept++] = c[i];
     }
     return kept;
-}
-
-/* Crossings by estimated time (where the straight path crossed within the tested interval), ties by
- * index. A crossing is searched only if it has reached the gap by the earliest time found so far, so
- * the order changes which crossings are searched, not the earliest time (up to the search tolerance
- * and the choice among exact ties). In a pile hit from above a pass can hold 150 crossings in one
- * island, each search re-integrating the whole pile: earliest first took the step of the impact in
- * bench/repro/drop_into_pyramid.py from 196 searches to 134 (the estimate is rough there: paths under
- * contact forces are not straight). */
-typedef struct crossing_key { double t; int i; } crossing_key;
-
-static int by_estimated_time(const void *x, const void *y)
-{
-    const crossing_key *a = (const crossing_key *)x, *b = (const crossing_key *)y;
-    if (a->t != b->t) return a->t < b->t ? -1 : 1;
-    return (a->i > b->i) - (a->i < b->i);
-}
-
-static int order_crossings(lc_world *w, const lc_crossing *c, int nc, int *order)
-{
-    crossing_key *k = lc_buf_get(&w->b_cross_keys, (size_t)(nc > 0 ? nc : 1) * sizeof(crossing_key));
-    int i;
-    if (k == NULL) return -1;
-    for (i = 0; i < nc; ++i) {
-        k[i].t = c[i].t_lo + c[i].path_fraction * (c[i].t_hi - c[i].t_lo);
-        if (!(k[i].t == k[i].t)) k[i].t = c[i].t_hi;   /* NaN keys would break the sort's order */
-        k[i].i = i;
-    }
-    if (nc > 1) qsort(k, (size_t)nc, sizeof *k, by_estimated_time);
-    for (i = 0; i < nc; ++i) order[i] = k[i].i;
-    return 0;
 }
 
 /* Contact forces do no work beyond round-off; a trial interval in which the bodies they act on gain
@@ -997,10 +962,7 @@ lc_status lc_world_step(lc_world *w, double dt)
                     coupled[lc_world_body_index(w, w->springs[i].def.body_b)] = 1;
                 }
         }
-        for (i = nkept; i < nc; ++i) {
-            ((lc_crossing *)w->b_cross.p)[i].t_lo = 0.0;
-            ((lc_crossing *)w->b_cross.p)[i].t_hi = trial;
-        }
+        for (i = nkept; i < nc; ++i) ((lc_crossing *)w->b_cross.p)[i].t_hi = trial;
         nc = swept_check(w, s0, s1, trial, pairs, np, nc, coupled, rows, nrows, rest, nrest);
         lc_stage_end(w, &w->last.time_detection, ts);
         if (nc < 0) goto oom;
@@ -1014,15 +976,12 @@ lc_status lc_world_step(lc_world *w, double dt)
         if (nc > 0 && build_islands(w, rows, nrows, rest, nrest, &isl) != 0) goto oom;
         {
             double *at_best = NULL, at_t = -1.0;
-            int at_ia = -2, at_ib = -2, q, *order = lc_buf_get(&w->b_cross_order, (size_t)(nc > 0 ? nc : 1) * sizeof(int));
-            if (order == NULL) goto oom;
-            if (order_crossings(w, cross, nc, order) != 0) goto oom;
-            for (q = 0; q < nc && !(best >= 0 && tmin == 0.0); ++q) {
+            int at_ia = -2, at_ib = -2;
+            for (i = 0; i < nc && !(best >= 0 && tmin == 0.0); ++i) {
                 double tau;
                 const int *erows;
                 int nerows, nerest;
                 lc_touch *erest;
-                i = order[q];
                 if (islands_of(w, &isl, cross[i].a, cross[i].b, &erows, &nerows, &erest, &nerest) != 0) goto oom;
                 if (best >= 0) {
                     double g;

@@ -122,7 +122,7 @@ struct lc_world {
     lc_buf b_fric;           /* impulse.c: friction rows of an impact */
     lc_buf b_cfric;          /* contact_forces.c: normal and tangent blocks of a friction group */
     /* b_hash, step.c only: hash of the resting vertices of a pass */
-    lc_buf b_cross, b_cross_order, b_cross_keys, b_impact, b_irows, b_coupled, b_dacc, b_diag, b_warm, b_hash;
+    lc_buf b_cross, b_impact, b_irows, b_coupled, b_dacc, b_diag, b_warm, b_hash;
     int warm_count;          /* resting touches kept in b_warm from the previous pass (warm start) */
     double step_dt;          /* dt of the step in progress (stabilisation time scale) */
 };
@@ -168,10 +168,7 @@ int lc_collect_touches(const lc_world *w, const double *state, int a, int b, dou
                        lc_buf *buf, int count);
 /* Crossing found between two states: vertex of row a entered edge of row b. */
 /* t_hi: a time (from the interval's start) by which the vertex is known to be inside. */
-/* A vertex of a that entered b between two tested states. t_lo, t_hi: the tested interval (s from the
- * pass's start); path_fraction: where along it the vertex's straight path (in b's frame) met the
- * edge's line, 1 when rotation carried it in: an estimate of its time that orders the searches. */
-typedef struct lc_crossing { int a, b, vertex, edge; double path_fraction, t_lo, t_hi; } lc_crossing;
+typedef struct lc_crossing { int a, b, vertex, edge; double toi, t_hi; } lc_crossing;
 /* Appends crossings of the pair (a, b) between state0 and state1. Returns new count or -1. */
 int lc_find_crossings(const lc_world *w, const double *s0, const double *s1, int a, int b,
                       lc_buf *buf, int count);
