@@ -246,17 +246,9 @@ int lc_resolve_impacts(lc_world *w, double *state, lc_touch *t, int n, int elast
         /* A pair resolved over and over is a jam (blocks pressed together, a resting pile), not a
          * propagating impact: after a few passes per pair the inelastic simultaneous pass closes it. */
         int pairs = 1, cap;
-        uint64_t used = w->last.serial_iterations;
         for (i = 1; i < n; ++i) if (!same_pair(&t[i], &t[i - 1])) ++pairs;
         cap = 4 * pairs + 16;
         if (cap > w->def.max_serial_iterations) cap = w->def.max_serial_iterations;
-        /* A step's serial passes are budgeted: a heavy box into a frictional 78-box pyramid makes ~90
-         * impacts of the whole pile within one step, each up to max_serial_iterations passes; that
-         * step used to be undone after 50 000 of them (4 minutes of CPU) and so could never be taken.
-         * Past the budget, every impact of the step gets the inelastic simultaneous pass at once, as
-         * a jam does; inputs like a 1e6 kg and a 1e-300 kg box at 1e6 m/s end the same way. */
-        if (used >= LC_SERIAL_ITERATIONS_PER_STEP) cap = 0;
-        else if ((uint64_t)cap > LC_SERIAL_ITERATIONS_PER_STEP - used) cap = (int)(LC_SERIAL_ITERATIONS_PER_STEP - used);
         for (iter = 0; iter < cap; ++iter) {
             int worst = -1, start, end, k;
             double vworst = -eps;

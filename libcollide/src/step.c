@@ -9,12 +9,12 @@
 #define LC_MAX_TRIAL_ROTATION 0.25
 /* Most rotation-limited intervals in one step. */
 #define LC_MAX_TRIALS 1024
-/* Most force evaluations one step may do before it is undone with LC_ERR_NUMERIC. A 210-box pyramid
- * needs ~30 per step and the seed scene none; this is reached only by inputs such as a stiff spring
- * anchored 1e6 m away, which would otherwise spend seconds on one step before failing anyway. (Serial
- * impulse passes have a budget too, LC_SERIAL_ITERATIONS_PER_STEP, but past it impacts are resolved
- * simultaneously instead: see impulse.c.) */
+/* Most work one step may do before it is undone with LC_ERR_NUMERIC: force evaluations and serial
+ * impulse passes. A 210-box pyramid needs ~30 evaluations per step and the seed scene none; these
+ * are reached only by inputs such as a 1e6 kg and a 1e-300 kg body at 1e6 m/s, or a stiff spring
+ * anchored 1e6 m away, which would otherwise spend seconds on one step before failing anyway. */
 #define LC_MAX_FORCE_EVALUATIONS_PER_STEP 500000u
+#define LC_MAX_SERIAL_ITERATIONS_PER_STEP 50000u
 
 /* The touches the last step's projection found at the state it ended in, moved into buf, if this
  * gather is at that same state (-1: none kept, or something changed since). The first gather of a
@@ -896,9 +896,11 @@ lc_status lc_world_step(lc_world *w, double dt)
         if (++passes > w->def.max_events_per_step + 2 * LC_MAX_TRIALS)
             return step_failed(w, backup, time0, LC_ERR_NUMERIC,
                                "the step needed more than max_events_per_step impacts and intervals (stiff forces or extreme speeds?)");
-        if (w->last.force_evaluations > LC_MAX_FORCE_EVALUATIONS_PER_STEP)
+        if (w->last.force_evaluations > LC_MAX_FORCE_EVALUATIONS_PER_STEP ||
+            w->last.serial_iterations > LC_MAX_SERIAL_ITERATIONS_PER_STEP)
             return step_failed(w, backup, time0, LC_ERR_NUMERIC,
-                               "the step needed more than 500000 force evaluations (stiff forces or extreme speeds?)");
+                               "the step needed more than 500000 force evaluations or 50000 serial impulse passes "
+                               "(stiff forces or extreme speeds?)");
         /* After an impact in free flight (nothing resting, no spring between bodies, the same trial
          * end), only the bodies of that impact move differently: every other body keeps its trial
          * path to the previous trial's end, and the crossings found between two such bodies stay

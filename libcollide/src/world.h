@@ -240,8 +240,6 @@ int lc_integrate(lc_world *w, const double *s0, double h, const int *rows, int n
  * restitution when `elastic`, else perfectly inelastic. Returns the number of points that received an
  * impulse, or -1 on allocation failure. */
 int lc_resolve_impacts(lc_world *w, double *state, lc_touch *t, int n, int elastic);
-/* Serial impulse passes one step may use; after them its impacts are resolved simultaneously. */
-#define LC_SERIAL_ITERATIONS_PER_STEP 50000u
 
 /* ---- time_of_impact.c ---- */
 /* Time in [0, h] at which the crossing's gap reaches the contact gap; integrates the listed rows. */
