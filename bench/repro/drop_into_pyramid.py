@@ -23,9 +23,14 @@ The script stops after --cpu seconds of CPU or --steps steps, whichever comes fi
 progress is not interrupted.
 """
 import argparse
+import sys
 import time
+from pathlib import Path
 
 import collide
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+import scenes  # noqa: E402  (bench/scenes.py)
 
 ap = argparse.ArgumentParser()
 ap.add_argument("--base", type=int, default=12)
@@ -33,11 +38,9 @@ ap.add_argument("--steps", type=int, default=12)
 ap.add_argument("--cpu", type=float, default=600.0)
 a = ap.parse_args()
 w = collide.World(gravity=(0.0, -10.0), damping=0.0)
-for i in range(a.base):
-    for j in range(i, a.base):
-        x = (i + 1.0) * 0.5 + (j - i) * 1.0 - 0.5 * a.base
-        w.add_box(1.0, 1.0, position=(x, 0.5 + i), mass=1.0, elasticity=0.0, friction=0.6)
-w.add_box(2.0 * a.base + 20.0, 1.0, position=(0.0, -0.5), static=True, elasticity=0.5, friction=0.6)
+for b in scenes.pyramid(a.base).boxes:   # bench/run's layout, the ground last
+    w.add_box(b.w, b.h, position=(b.x, b.y), mass=b.mass, static=b.static, elasticity=0.5 if b.static else 0.0,
+              friction=0.6)
 w.add_box(1.0, 1.0, position=(0.3, a.base + 2.0), velocity=(0.0, -8.0), angular_velocity=1.0, mass=5.0,
           elasticity=0.5, friction=0.6)
 total = 0.0

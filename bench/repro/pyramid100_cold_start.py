@@ -15,9 +15,14 @@ comes first; a step in progress is not interrupted.
     source scripts/env.sh && python bench/repro/pyramid100_cold_start.py [--base 100] [--steps 3] [--cpu 120]
 """
 import argparse
+import sys
 import time
+from pathlib import Path
 
 import collide
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+import scenes  # noqa: E402  (bench/scenes.py)
 
 ap = argparse.ArgumentParser()
 ap.add_argument("--base", type=int, default=100)
@@ -25,11 +30,8 @@ ap.add_argument("--steps", type=int, default=3)
 ap.add_argument("--cpu", type=float, default=120.0)
 a = ap.parse_args()
 w = collide.World(gravity=(0.0, -10.0), damping=0.0)
-for i in range(a.base):
-    for j in range(i, a.base):
-        x = (i + 1.0) * 0.5 + (j - i) * 1.0 - 0.5 * a.base
-        w.add_box(1.0, 1.0, position=(x, 0.5 + i), mass=1.0, elasticity=0.0, friction=0.6)
-w.add_box(2.0 * a.base + 20.0, 1.0, position=(0.0, -0.5), static=True, elasticity=0.0, friction=0.6)
+for b in scenes.pyramid(a.base).boxes:   # bench/run's layout, the ground last
+    w.add_box(b.w, b.h, position=(b.x, b.y), mass=b.mass, static=b.static, elasticity=0.0, friction=0.6)
 total = 0.0
 for k in range(a.steps):
     t0 = time.process_time()

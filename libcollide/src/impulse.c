@@ -77,13 +77,6 @@ static int solve_block_friction(lc_world *w, double *state, lc_touch *t, int n, 
 /* Most alternations between the normal and the friction rows of a large impact. */
 #define LC_IMPULSE_FRICTION_ROUNDS 4
 
-/* The impulse problem of a large group (more touches than lcp_exact_max: an impact into a pile, the
- * inelastic pass closing a jam) by MPRGP on the sparse response (sparse_lcp.c): O(touches) memory and
- * work per product instead of a dense n x n matrix (7000 touches of a base-50 pyramid: 392 MB). Same
- * model as the small problem: compression impulses, the tangent rows (stopping the sliding within
- * |j_t| <= mu j_n) alternated with the normal ones, then (1 + e) times the normal ones. Converged when
- * no point is left approaching faster than a thousandth of resting_speed, well inside what the
- * resting test treats as at rest. */
 /* The normal rows of a large impact with the friction impulses jt held: jn (warm start and answer)
  * from MPRGP; rhs, lo, hi: scratch of n. Returns products of A used, or -1. */
 static int normal_impulses(lc_world *w, const lc_touch *t, int n, const double *jt, const double *vn0, double *body,
@@ -108,6 +101,13 @@ static void clip_to_cone(const lc_touch *t, int n, const double *jn, double *jt)
     }
 }
 
+/* The impulse problem of a large group (more touches than lcp_exact_max: an impact into a pile, the
+ * inelastic pass closing a jam) by MPRGP on the sparse response (sparse_lcp.c): O(touches) memory and
+ * work per product instead of a dense n x n matrix (7000 touches of a base-50 pyramid: 392 MB). Same
+ * model as the small problem: compression impulses, the tangent rows (stopping the sliding within
+ * |j_t| <= mu j_n) alternated with the normal ones, then (1 + e) times the normal ones. Converged when
+ * no point is left approaching faster than a thousandth of resting_speed, well inside what the
+ * resting test treats as at rest. */
 static int solve_block_sparse(lc_world *w, double *state, lc_touch *t, int n, int restitute)
 {
     double *v = lc_buf_get(&w->b_fric, (size_t)n * 8 * sizeof(double));

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import struct
 from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 
@@ -98,6 +99,11 @@ def split_time(t: float) -> tuple[int, int]:
     if ns < 0:
         ns = 0
     return ns // 1_000_000_000, ns % 1_000_000_000
+
+
+def join_time(t: Any) -> float:
+    """builtin_interfaces/Time (anything with .sec and .nanosec) -> seconds (float); split_time's inverse."""
+    return t.sec + 1e-9 * t.nanosec
 
 
 def poses_from_state(state: np.ndarray) -> np.ndarray:

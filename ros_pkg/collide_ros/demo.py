@@ -32,6 +32,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from .cdr import join_time
 from .teleop import LEFT, RIGHT, UP
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -145,7 +146,7 @@ class Driver:
         self.sent = 0
 
     def _on_clock(self, m: Any) -> None:
-        self.sim_time = m.clock.sec + 1e-9 * m.clock.nanosec
+        self.sim_time = join_time(m.clock)
 
     def _on_states(self, m: Any) -> None:
         for n, p in zip(m.names, m.poses):
@@ -261,7 +262,7 @@ def summarize(msgs: dict[str, list[tuple[int, Any]]], t0: float, coast_from: flo
     from .render import _topic
 
     def stamp(m: Any) -> float:
-        return m.header.stamp.sec + 1e-9 * m.header.stamp.nanosec
+        return join_time(m.header.stamp)
 
     states = _topic(msgs, "bodies/states")
     energy = _topic(msgs, "energy")

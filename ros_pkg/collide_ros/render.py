@@ -22,6 +22,8 @@ from typing import Any, Iterable, Sequence
 import numpy as np
 from PIL import Image, ImageDraw, ImageFont
 
+from .cdr import join_time
+
 BG = (250, 250, 250)
 WALL = (120, 120, 120)
 GREEN = (60, 170, 70)
@@ -226,7 +228,7 @@ def yaw(qz: float, qw: float) -> float:
 # ------------------------------------------------------------------ bag -> frames
 
 def _stamp(h: Any) -> float:
-    return float(h.stamp.sec) + 1e-9 * float(h.stamp.nanosec)
+    return join_time(h.stamp)
 
 
 def read_bag(bag: str | Path, store: Any | None = None) -> dict[str, list[tuple[int, Any]]]:

@@ -33,6 +33,7 @@ from typing import Any
 
 import numpy as np
 
+from .cdr import join_time
 from .recorder import PARAMS_KEY
 
 APPLIED = "applied/"
@@ -261,7 +262,7 @@ class Replayer:
                 probe = self.handshake(timeout)
                 if probe is None:
                     raise RuntimeError(f"~/step {k} failed: timeout, and the node answers no zero-step call")
-                t = probe.sim_time.sec + 1e-9 * probe.sim_time.nanosec
+                t = join_time(probe.sim_time)
                 moved = round((t - self.sim_time) / self.time_step)
                 if moved == 0:
                     continue  # the request was lost: send it again
@@ -270,7 +271,7 @@ class Replayer:
                 res = probe
             elif not res.success:
                 raise RuntimeError(f"~/step {k} failed: {res.message}")
-            self.sim_time = res.sim_time.sec + 1e-9 * res.sim_time.nanosec
+            self.sim_time = join_time(res.sim_time)
             self.steps += k
             n -= k
             self.rclpy.spin_once(self.node, timeout_sec=0.0)
@@ -333,7 +334,7 @@ def replay(bag: str | Path, node_cmd: list[str] | None = None, env: dict[str, st
             first = rep.handshake(60.0)
             if first is None:
                 raise RuntimeError("fresh node's ~/step never answered a zero-step call")
-            rep.sim_time = first.sim_time.sec + 1e-9 * first.sim_time.nanosec
+            rep.sim_time = join_time(first.sim_time)
             for i, c in enumerate(cmds):
                 k = round(c.stamp * 1e-9 / dt) + (1 if i == delay_command else 0)
                 if k < rep.steps:

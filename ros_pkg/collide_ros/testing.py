@@ -30,6 +30,8 @@ from rosgraph_msgs.msg import Clock
 from tf2_msgs.msg import TFMessage
 from visualization_msgs.msg import MarkerArray
 
+from .cdr import join_time
+
 REPO = Path(__file__).resolve().parents[2]
 
 
@@ -233,7 +235,7 @@ class SimClient:
 
     def sim_time(self, timeout: float = 10.0) -> float | None:
         msg = self.fresh("clock", timeout=timeout)
-        return None if msg is None else msg.clock.sec + 1e-9 * msg.clock.nanosec
+        return None if msg is None else join_time(msg.clock)
 
     def body_state(self, name: str, timeout: float = 10.0) -> tuple[float, ...] | None:
         """(x, y, yaw, vx, vy, omega) from a fresh bodies/states message."""

@@ -8,13 +8,14 @@ from typing import Any
 
 import pytest
 
+from collide_ros.cdr import split_time
 from collide_ros.replay import Replayer
 
 DT = 0.001
 
 
 class ScriptedNode:
-    """Serves ~/step like the sim node; `drop` lists call indices whose answer (or request) is lost."""
+    """Serves ~/step like the sim node; drop_answer / drop_request: call indices whose answer / request is lost."""
 
     def __init__(self, drop_answer: set[int], drop_request: set[int]) -> None:
         self.steps = 0
@@ -31,8 +32,8 @@ class ScriptedNode:
         self.served.append(k)
         if i in self.drop_answer:
             return None
-        t = self.steps * DT
-        return SimpleNamespace(success=True, message="", sim_time=SimpleNamespace(sec=int(t), nanosec=round((t % 1) * 1e9)))
+        sec, nanosec = split_time(self.steps * DT)
+        return SimpleNamespace(success=True, message="", sim_time=SimpleNamespace(sec=sec, nanosec=nanosec))
 
 
 def _replayer(node: ScriptedNode) -> Replayer:
