@@ -314,6 +314,7 @@ static void add_counters(lc_counters *total, const lc_counters *last)
     total->contact_solve_iterations += last->contact_solve_iterations;
     total->impulse_solves += last->impulse_solves;
     total->position_projections += last->position_projections;
+    total->quiet_advances += last->quiet_advances;
     if (last->max_lcp_residual > total->max_lcp_residual) total->max_lcp_residual = last->max_lcp_residual;
     total->time_step += last->time_step;
     total->time_detection += last->time_detection;

@@ -11,7 +11,9 @@
  *     resting contact spends time in every stage, the six disjoint stages sum to no more than the
  *     whole step (they do not overlap; the remainder is bookkeeping between them), and the contact
  *     force solves fit inside the integration and time-of-impact stages that run them; off again,
- *     no more time is added; 2 is refused with a message. The physics is the same bit for bit. */
+ *     no more time is added; 2 is refused with a message. The physics is the same bit for bit.
+ * (5) a resting stack is advanced with two force evaluations per interval (see quiet_rest). */
+#include <math.h>
 #include <string.h>
 #include "check.h"
 #include "scenes.h"
@@ -58,6 +60,82 @@ static void resting_is_counted(void)
     CHECK(tot.resting_contacts > 0, "%s", "resting contacts counted");
     CHECK(tot.force_evaluations + tot.analytic_advances > 0, "%s", "the body was advanced");
     lc_world_destroy(w);
+}
+
+/* (5) A resting stack needs two force evaluations per interval, not RK4's four: a 4-box stack on a
+ * floor takes every step after the first as one quiet advance (2 evaluations), and stays put to 1 %
+ * of the contact gap (the end-of-step projection holds every gap at contact_gap). A box at rest that
+ * a stiff spring tears off the floor is quiet at the start (v = 0) but its acceleration changes by
+ * far more than the tolerance over the interval: the attempt is refused, and the step is RK4's bit
+ * for bit (the same world with resting_speed 0, which never attempts it: a touch at v = 0 rests
+ * either way). */
+static lc_world *spring_lift(double resting_speed, lc_body_id *box)
+{
+    lc_world_def d = lc_default_world_def();
+    lc_spring_def sp = lc_default_spring_def();
+    lc_spring_id sid;
+    lc_world *w;
+    d.gravity.y = -10.0;
+    d.resting_speed = resting_speed;
+    w = sc_world(&d);
+    if (!w) return NULL;
+    sc_static_box(w, 10.0, 1.0, 0.0, -0.5, 0.0);
+    *box = sc_box(w, 1.0, 1.0, 0.0, 0.5 + d.contact_gap, 0.0, 0, 0, 0, 1.0, 0.0);
+    sp.body_a = *box;
+    sp.point_a.y = 0.5;
+    sp.body_b = LC_WORLD_ANCHOR;
+    sp.point_b.y = 3.0;
+    sp.stiffness = 1000.0;
+    CHECK(lc_world_add_spring(w, &sp, &sid) == LC_OK, "add spring: %s", lc_world_last_error(w));
+    return w;
+}
+
+static void quiet_rest(void)
+{
+    lc_world_def d = lc_default_world_def();
+    lc_world *w, *a, *b;
+    lc_body_id top = 0, ba, bb;
+    lc_counters last, tot;
+    double y0, dy;
+    int k, quiet_steps = 0;
+    d.gravity.y = -10.0;
+    w = sc_world(&d);
+    if (!w) return;
+    sc_static_box(w, 10.0, 1.0, 0.0, -0.5, 0.0);
+    for (k = 0; k < 4; ++k) top = sc_box(w, 1.0, 1.0, 0.0, 0.5 + (k + 1) * d.contact_gap + k, 0.0, 0, 0, 0, 1.0, 0.0);
+    sc_step_n(w, 1.0 / 60.0, 1);
+    y0 = sc_row(w, top)[1];
+    for (k = 1; k < 60; ++k) {
+        sc_step_n(w, 1.0 / 60.0, 1);
+        lc_world_get_counters(w, &last, NULL);
+        if (last.quiet_advances == 1 && last.force_evaluations == 2) quiet_steps++;
+    }
+    lc_world_get_counters(w, NULL, &tot);
+    dy = sc_row(w, top)[1] - y0;
+    printf("resting stack: %d of 59 steps quiet (2 force evaluations), %llu quiet advances, top moved %.3g m\n",
+           quiet_steps, (unsigned long long)tot.quiet_advances, dy);
+    CHECK(quiet_steps == 59, "every step of a resting stack is one quiet advance of 2 evaluations (%d of 59)",
+          quiet_steps);
+    CHECK(fabs(dy) < 0.01 * d.contact_gap, "the quiet stack stays put (top moved %.3g m)", dy);
+    lc_world_destroy(w);
+
+    a = spring_lift(d.resting_speed, &ba);
+    b = spring_lift(0.0, &bb);
+    if (!a || !b) return;
+    sc_step_n(a, 1.0 / 60.0, 1);
+    sc_step_n(b, 1.0 / 60.0, 1);
+    lc_world_get_counters(a, &last, NULL);
+    printf("spring lift: quiet advances %llu, force evaluations %llu, y %.17g vs %.17g\n",
+           (unsigned long long)last.quiet_advances, (unsigned long long)last.force_evaluations, sc_row(a, ba)[1],
+           sc_row(b, bb)[1]);
+    CHECK(last.quiet_advances == 0, "a box torn off the floor is not advanced as quiet (%llu)",
+          (unsigned long long)last.quiet_advances);
+    CHECK(sc_row(a, ba)[1] > 0.5 + 1e-3, "the spring lifted the box (y %.6g)", sc_row(a, ba)[1]);
+    CHECK(memcmp(sc_row(a, ba), sc_row(b, bb), 6 * sizeof(double)) == 0,
+          "a refused quiet attempt leaves RK4's step bit for bit (y %.17g vs %.17g)", sc_row(a, ba)[1],
+          sc_row(b, bb)[1]);
+    lc_world_destroy(a);
+    lc_world_destroy(b);
 }
 
 /* n bodies of 0.2 m on a grid with 1 m pitch (columns of 10), slow random drift, g = 0. */
@@ -213,5 +291,6 @@ int main(void)
     broadphase(40, LC_BROADPHASE_BRUTE_FORCE, 0);
     broadphase_equivalence();
     stage_timing();
+    quiet_rest();
     return CHECK_SUMMARY("test_counters");
 }

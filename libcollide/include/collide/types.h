@@ -204,6 +204,7 @@ typedef struct lc_counters {
     uint64_t contact_solve_iterations;/* pivots, or products of the response matrix (large groups), in those solves */
     uint64_t impulse_solves;          /* complementarity solves for impulses */
     uint64_t position_projections;    /* end-of-step corrections of points found inside another body */
+    uint64_t quiet_advances;          /* RK4 intervals of resting bodies taken with two force evaluations */
     double max_lcp_residual;          /* largest residual of an iterative contact-force solve: relative for
                                          groups up to lcp_exact_max, m/s^2 of relative acceleration above */
     /* s of wall time per pipeline stage, measured only while lc_world_set_stage_timing is on (else 0).
