@@ -411,7 +411,10 @@ static void fz_set_def(fz_in *in, lc_world_def *d)
         case 9: d->toi_max_iterations = fz_int(in, 4, 200); break;
         case 10: d->contact_gap = fz_num(in, 1e-10, 1e-5); break;
         case 11: d->contact_distance = fz_num(in, 1e-6, 1e-3); break;
-        case 12: d->resting_speed = fz_num(in, 0.0, 1e-2); break;
+        case 12:   /* the threshold follows without a byte of its own, so older inputs decode as before */
+            d->resting_speed = fz_num(in, 0.0, 1e-2);
+            d->restitution_threshold = 100.0 * d->resting_speed;
+            break;
         case 13: d->stabilization = (lc_stabilization)fz_int(in, 0, 2); break;
         case 14: d->elasticity_rule = (lc_mix_rule)fz_int(in, 0, 3); break;
         case 15: d->friction_rule = (lc_mix_rule)fz_int(in, 0, 3); break;

@@ -12,6 +12,15 @@
 #include <string.h>
 #include "world.h"
 
+/* Approach speed (m/s) above which an impact at this touch bounces: restitution_threshold, not below
+ * resting_speed. Perfectly elastic pairs (e >= 1) bounce down to resting_speed, so energy is kept
+ * exactly where the scene asks for it. */
+static double bounce_speed(const lc_world *w, const lc_touch *t)
+{
+    if (t->elasticity >= 1.0) return w->def.resting_speed;
+    return fmax(w->def.resting_speed, w->def.restitution_threshold);
+}
+
 static double normal_velocity(const double *state, const lc_touch *t)
 {
     const double *sa = &state[t->a * 6], *sb = &state[t->b * 6];
@@ -170,9 +179,11 @@ static int solve_block_sparse(lc_world *w, double *state, lc_touch *t, int n, in
 }
 
 /* Solves the impulse problem for touches t[0..n) and applies it: restitution (use_e) by Poisson's
- * rule, e = 0 when no point approaches faster than resting_speed (so settling ends instead of
- * bouncing ever smaller: the seed's Zeno "stuck" case). Returns the number of points that received
- * a positive impulse, or -1. */
+ * rule, e = 0 when no point approaches faster than its bounce_speed. A block settling at e = 0.8
+ * otherwise bounces ever smaller (the seed's Zeno "stuck" case) through every speed down to
+ * resting_speed: ~20 more impacts per settling corner, each a time-of-impact search, for bounces no
+ * higher than (e v)^2 / 2g = 3.3e-6 m below 1e-2 m/s. Returns the number of points that received a
+ * positive impulse, or -1. */
 static int solve_block(lc_world *w, double *state, lc_touch *t, int n, int use_e)
 {
     double *A, *b, *j;
@@ -181,7 +192,7 @@ static int solve_block(lc_world *w, double *state, lc_touch *t, int n, int use_e
     int i, hits = 0, with_friction = 0, restitute = 0;
     if (n > w->def.lcp_exact_max) {
         for (i = 0; i < n && !restitute; ++i)
-            if (use_e && normal_velocity(state, &t[i]) < -w->def.resting_speed) restitute = 1;
+            if (use_e && normal_velocity(state, &t[i]) < -bounce_speed(w, &t[i])) restitute = 1;
         return solve_block_sparse(w, state, t, n, restitute);
     }
     A = lc_buf_get(&w->b_mat, (size_t)n * (size_t)n * sizeof(double));
@@ -196,7 +207,7 @@ static int solve_block(lc_world *w, double *state, lc_touch *t, int n, int use_e
     lc_response_matrix(w, t, n, A);
     for (i = 0; i < n; ++i) {
         b[i] = normal_velocity(state, &t[i]);
-        if (use_e && b[i] < -w->def.resting_speed) restitute = 1;
+        if (use_e && b[i] < -bounce_speed(w, &t[i])) restitute = 1;
         if (t[i].friction > 0.0) with_friction = 1;
         j[i] = 0.0;
     }

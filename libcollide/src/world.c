@@ -87,6 +87,7 @@ lc_world_def lc_default_world_def(void)
     d.contact_gap = 1e-7;
     d.contact_distance = 1e-5;
     d.resting_speed = 1e-4;
+    d.restitution_threshold = 1e-2;
     d.stabilization = LC_STABILIZE_VELOCITY;
     d.elasticity_rule = LC_MIX_MIN;
     d.friction_rule = LC_MIX_GEOMETRIC;
@@ -156,6 +157,7 @@ static lc_status validate_world_def(lc_world *w, const lc_world_def *d)
     if (!(d->toi_distance_tolerance < d->contact_gap))
         return lc_fail(w, LC_ERR_OUT_OF_RANGE, "toi_distance_tolerance = %g must be below contact_gap = %g", d->toi_distance_tolerance, d->contact_gap);
     CHECK_RANGE(w, d->resting_speed, 0.0, 10.0, "resting_speed");
+    CHECK_RANGE(w, d->restitution_threshold, 0.0, 10.0, "restitution_threshold");
     if (d->stabilization != LC_STABILIZE_NONE && d->stabilization != LC_STABILIZE_VELOCITY && d->stabilization != LC_STABILIZE_VELOCITY_AND_DISTANCE)
         return lc_fail(w, LC_ERR_BAD_ENUM, "stabilization = %d is not an lc_stabilization", (int)d->stabilization);
     if (!mix_rule_ok(d->elasticity_rule)) return lc_fail(w, LC_ERR_BAD_ENUM, "elasticity_rule = %d is not an lc_mix_rule", (int)d->elasticity_rule);

@@ -40,6 +40,7 @@ static int def_equal(const lc_world_def *a, const lc_world_def *b)
            a->toi_time_tolerance == b->toi_time_tolerance && a->toi_distance_tolerance == b->toi_distance_tolerance &&
            a->toi_max_iterations == b->toi_max_iterations && a->contact_gap == b->contact_gap &&
            a->contact_distance == b->contact_distance && a->resting_speed == b->resting_speed &&
+           a->restitution_threshold == b->restitution_threshold &&
            a->stabilization == b->stabilization && a->elasticity_rule == b->elasticity_rule &&
            a->friction_rule == b->friction_rule && a->max_events_per_step == b->max_events_per_step &&
            a->max_serial_iterations == b->max_serial_iterations && a->lcp_exact_max == b->lcp_exact_max &&
@@ -128,6 +129,7 @@ static void world_def_errors(lc_world *w)
         {offsetof(lc_world_def, contact_gap), "contact_gap"},
         {offsetof(lc_world_def, contact_distance), "contact_distance"},
         {offsetof(lc_world_def, resting_speed), "resting_speed"},
+        {offsetof(lc_world_def, restitution_threshold), "restitution_threshold"},
         {offsetof(lc_world_def, lcp_tolerance), "lcp_tolerance"},
     };
     const struct { size_t off; const char *name; double v; } ranges[] = {
@@ -143,6 +145,8 @@ static void world_def_errors(lc_world *w)
         {offsetof(lc_world_def, contact_distance), "contact_distance", 1.5},
         {offsetof(lc_world_def, resting_speed), "resting_speed", -0.1},
         {offsetof(lc_world_def, resting_speed), "resting_speed", 11.0},
+        {offsetof(lc_world_def, restitution_threshold), "restitution_threshold", -0.1},
+        {offsetof(lc_world_def, restitution_threshold), "restitution_threshold", 11.0},
         {offsetof(lc_world_def, lcp_tolerance), "lcp_tolerance", -0.1},
         {offsetof(lc_world_def, lcp_tolerance), "lcp_tolerance", 1.5},
     };
@@ -517,8 +521,9 @@ static void defaults(void)
           "%s", "default RK4, serial, root finder");
     CHECK(d.toi_time_tolerance == 1e-10 && d.toi_distance_tolerance == 1e-10 && d.toi_max_iterations == 100, "%s",
           "default TOI tolerances 1e-10 s, 1e-10 m, 100 iterations");
-    CHECK(d.contact_gap == 1e-7 && d.contact_distance == 1e-5 && d.resting_speed == 1e-4, "%s",
-          "default contact_gap 1e-7, contact_distance 1e-5, resting_speed 1e-4");
+    CHECK(d.contact_gap == 1e-7 && d.contact_distance == 1e-5 && d.resting_speed == 1e-4 &&
+              d.restitution_threshold == 1e-2, "%s",
+          "default contact_gap 1e-7, contact_distance 1e-5, resting_speed 1e-4, restitution_threshold 1e-2");
     CHECK(d.stabilization == LC_STABILIZE_VELOCITY && d.elasticity_rule == LC_MIX_MIN &&
               d.friction_rule == LC_MIX_GEOMETRIC, "%s", "default stabilisation and mix rules");
     CHECK(d.max_events_per_step == 10000 && d.max_serial_iterations == 1000 && d.lcp_exact_max == 128 &&

@@ -1,6 +1,7 @@
 /* test_impulse: single corner impacts against eq. 11 of the seed page in closed form.
  * (1) a rotated block hits a static wall with one corner (wall limit m_b, I_b -> infinity), with and
- *     without spin; (2) two free blocks, an eccentric corner-on-face impact.
+ *     without spin; (2) two free blocks, an eccentric corner-on-face impact; (3) the restitution
+ *     threshold (below it an impact of a pair with e < 1 does not bounce).
  * g = 0, no damping, so between impacts the motion is uniform translation + rotation and the time
  * of impact can be found here independently (bisection to 1e-15 s on the analytic corner path).
  *
@@ -217,6 +218,32 @@ static void block_block_case(double e)
     lc_world_destroy(w);
 }
 
+/* (3) The restitution threshold, g = 0: a block (e_block, the floor's e 1, mixed by min) moving down
+ * at v onto a static floor 1 mm below. Above the threshold it leaves at e v (eq. 11, one point per
+ * corner pair, flat); below it the impact is inelastic and the block stays at the floor (|vy| below
+ * resting_speed, where contact forces hold it); at e = 1 it bounces at any speed above
+ * resting_speed, so energy is kept. Velocities to 1e-9 m/s: a 1e-10 s timing error changes nothing
+ * here (g = 0, no spin). */
+static void threshold_case(double v, double e_block, double threshold, double expect_vy)
+{
+    lc_world_def d = sc_def_zero_g();
+    lc_world *w;
+    lc_body_id b;
+    double vy;
+    d.restitution_threshold = threshold;
+    w = sc_world(&d);
+    if (!w) return;
+    sc_static_box(w, 10.0, 1.0, 0.0, -0.5, 1.0);
+    b = sc_box(w, 1.0, 0.5, 0.0, 0.25 + 1e-3, 0.0, 0.0, -v, 0.0, 1.0, e_block);
+    sc_step_n(w, 0.01, (int)(2e-3 / v / 0.01) + 2);
+    vy = sc_row(w, b)[4];
+    printf("threshold %g m/s, e %g, v %g m/s: leaves at %.12g m/s (expected %g)\n", threshold, e_block, v, vy,
+           expect_vy);
+    CHECK(fabs(vy - expect_vy) <= 1e-9, "threshold %g, e %g, v %g: vy %.12g, expected %g", threshold, e_block, v, vy,
+          expect_vy);
+    lc_world_destroy(w);
+}
+
 int main(void)
 {
     uint64_t it_root, it_bisect;
@@ -233,5 +260,9 @@ int main(void)
           (unsigned long long)it_bisect);
     block_block_case(1.0);
     block_block_case(0.6);
+    threshold_case(0.5, 0.5, 1e-2, 0.25);      /* above the default threshold: eq. 11 */
+    threshold_case(5e-3, 0.5, 1e-2, 0.0);      /* below: inelastic, then resting */
+    threshold_case(5e-3, 0.5, 0.0, 2.5e-3);    /* threshold 0: bounces down to resting_speed */
+    threshold_case(5e-3, 1.0, 1e-2, 5e-3);     /* e = 1 keeps bouncing: energy kept */
     return CHECK_SUMMARY("test_impulse");
 }

@@ -98,6 +98,7 @@ typedef struct lc_world_def {
     double contact_gap;            /* m, gap at which impacts are handled and resting contacts are held, [1e-12, 1e-2], default 1e-7 */
     double contact_distance;       /* m, gap below which bodies touch, > contact_gap, <= 1, default 1e-5 */
     double resting_speed;          /* m/s, approach speed below which a touch is resting, not an impact, [0, 10], default 1e-4 */
+    double restitution_threshold;  /* m/s, approach speed below which an impact does not bounce (pairs with e < 1), [0, 10], default 1e-2 */
     lc_stabilization stabilization;/* default LC_STABILIZE_VELOCITY */
     lc_mix_rule elasticity_rule;   /* default LC_MIX_MIN */
     lc_mix_rule friction_rule;     /* default LC_MIX_GEOMETRIC */
