@@ -12,8 +12,10 @@ What happens (session 6, docs/physics.md):
   solve spends its product budget (~2000 products instead of ~10-40 for a pile at rest).
 - Step 10 took 58 s and step 11 was undone after 288 s (the 50 000 serial impulse passes cap), so
   the simulation could not go on. Now an impulse solve that does not converge ends with its normal
-  rows, so no point is left approaching: step 10 takes 39 s (38 impacts instead of 67). Step 11 is
-  still undone at the cap. Going on past the cap with simultaneous inelastic impacts took it
+  rows, so no point is left approaching: step 10 took 39 s (38 impacts instead of 67), step 11 was
+  still undone at the cap. Since session 7's quiet advance of the resting pile (a round-off change
+  of its state before the impact) step 10 takes 27 s, step 11 317 s, and step 12 is undone at the cap
+  after 304 s: a different path, not a fix. Going on past the cap with simultaneous inelastic impacts took it
   through in 553 s, but made absurd fuzz inputs 10x slower and was reverted (docs/hardening.md,
   finding 29). The open problem is the friction solve of a pile in motion.
 

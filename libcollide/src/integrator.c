@@ -69,10 +69,11 @@ static int rows_quiet(const lc_world *w, const double *s, const int *rows, int n
  * interval up to the contact solver's tolerance, and RK4's four contact solves buy nothing over two.
  * k1 is known at s0; the rows are advanced under k1's accelerations held constant and evaluated again
  * there (k2). When no row's acceleration (a spin's at its farthest vertex) changed by more than
- * 2e-4 contact_gap / dt^2 (7.2e-8 m/s^2 at dt = 1/60, 1e-7 m; a resting pile's solves converge to
- * 9e-9), the interval is taken with the acceleration linear between the two, which moves a point less
- * than 1e-4 contact_gap from where any higher-order answer puts it; returns 1. Otherwise 0, and the
- * caller goes on with RK4 from k1 (one evaluation spent). */
+ * 2e-4 contact_gap / dt^2 (7.2e-8 m/s^2 at dt = 1/60 s and the default contact_gap; a resting pile's
+ * solves converge to 9e-9), the interval (h <= dt) is taken with the acceleration linear between the
+ * two, which puts a point less than h^2/2 of that, 1e-4 contact_gap, from where any higher-order
+ * answer puts it; returns 1. Otherwise 0, and the caller goes on with RK4 from k1 (one evaluation
+ * spent; tests/c/test_counters.c (5) checks that the step is then RK4's bit for bit). */
 static int advance_quiet(lc_world *w, const double *s0, double h, const int *irows, int ni, lc_touch *t, int nt,
                          double *acc, double *tmp, const double *k1, double *k2, double *s1)
 {
