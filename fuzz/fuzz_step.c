@@ -444,10 +444,10 @@ static void fz_step(fz_in *in, fz_ctx *c)
             int i;
             lc_world_get_def(c->w, &d);
             lc_world_get_state(c->w, &v);
-            fprintf(stderr, "fuzz_step: step %d dt=%.17g integrator=%d impact=%d toi=%d tol=%g/%g it=%d gap=%g dist=%g rest=%g stab=%d ev=%d ser=%d lcpx=%d lcpit=%d lcptol=%g g=(%.17g, %.17g) z=%.17g damp=%.17g ratio=%.17g rules=%d/%d bp=%d/%d\n",
+            fprintf(stderr, "fuzz_step: step %d dt=%.17g integrator=%d impact=%d toi=%d tol=%g/%g it=%d gap=%g dist=%g rest=%g bounce=%g stab=%d ev=%d ser=%d lcpx=%d lcpit=%d lcptol=%g g=(%.17g, %.17g) z=%.17g damp=%.17g ratio=%.17g rules=%d/%d bp=%d/%d\n",
                     c->steps, dt, (int)d.integrator, (int)d.impact_mode, (int)d.toi_method, d.toi_time_tolerance,
                     d.toi_distance_tolerance, d.toi_max_iterations, d.contact_gap, d.contact_distance, d.resting_speed,
-                    (int)d.stabilization, d.max_events_per_step, d.max_serial_iterations, d.lcp_exact_max,
+                    d.restitution_threshold, (int)d.stabilization, d.max_events_per_step, d.max_serial_iterations, d.lcp_exact_max,
                     d.lcp_max_iterations, d.lcp_tolerance, d.gravity.x, d.gravity.y, d.zero_energy_level, d.damping,
                     d.damping_rotation_ratio, (int)d.elasticity_rule, (int)d.friction_rule, (int)d.broadphase,
                     d.broadphase_threshold);

@@ -95,7 +95,7 @@ static void quiet_rest(void)
     lc_world_def d = lc_default_world_def();
     lc_world *w, *a, *b;
     lc_body_id top = 0, ba, bb;
-    lc_counters last, tot;
+    lc_counters last, tot, last_b;
     double y0, dy;
     int k, quiet_steps = 0;
     d.gravity.y = -10.0;
@@ -125,9 +125,13 @@ static void quiet_rest(void)
     sc_step_n(a, 1.0 / 60.0, 1);
     sc_step_n(b, 1.0 / 60.0, 1);
     lc_world_get_counters(a, &last, NULL);
-    printf("spring lift: quiet advances %llu, force evaluations %llu, y %.17g vs %.17g\n",
-           (unsigned long long)last.quiet_advances, (unsigned long long)last.force_evaluations, sc_row(a, ba)[1],
-           sc_row(b, bb)[1]);
+    lc_world_get_counters(b, &last_b, NULL);
+    printf("spring lift: quiet advances %llu, force evaluations %llu (RK4 alone %llu), y %.17g vs %.17g\n",
+           (unsigned long long)last.quiet_advances, (unsigned long long)last.force_evaluations,
+           (unsigned long long)last_b.force_evaluations, sc_row(a, ba)[1], sc_row(b, bb)[1]);
+    CHECK(last.force_evaluations == last_b.force_evaluations + 1,
+          "the quiet attempt was made and refused: one evaluation more than RK4 alone (%llu vs %llu)",
+          (unsigned long long)last.force_evaluations, (unsigned long long)last_b.force_evaluations);
     CHECK(last.quiet_advances == 0, "a box torn off the floor is not advanced as quiet (%llu)",
           (unsigned long long)last.quiet_advances);
     CHECK(sc_row(a, ba)[1] > 0.5 + 1e-3, "the spring lifted the box (y %.6g)", sc_row(a, ba)[1]);
