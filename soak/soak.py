@@ -238,6 +238,7 @@ def run_soak(duration: float, out: Path, seed: int = 1, state_rate: float = 10.0
     import rclpy
     from std_srvs.srv import Empty, SetBool
 
+    from collide_ros.cdr import join_time
     from collide_ros.testing import SimClient, _die_with_parent
 
     out.mkdir(parents=True, exist_ok=True)
@@ -313,7 +314,7 @@ def run_soak(duration: float, out: Path, seed: int = 1, state_rate: float = 10.0
             client.spin(0.005)
             st = client.last.get("bodies/states")
             if st is not None:
-                t = st.header.stamp.sec + 1e-9 * st.header.stamp.nanosec
+                t = join_time(st.header.stamp)
                 sim_t0 = t if sim_t0 is None else sim_t0
                 if any(abs(tw.linear.x) + abs(tw.linear.y) > 0 for tw in st.twists):
                     win_moving = True
@@ -322,7 +323,7 @@ def run_soak(duration: float, out: Path, seed: int = 1, state_rate: float = 10.0
                 res.rss_mib.append(round(rss, 2))
                 if now >= warm:
                     rss_after_warm.append(rss)
-                t_now = None if st is None else st.header.stamp.sec + 1e-9 * st.header.stamp.nanosec
+                t_now = None if st is None else join_time(st.header.stamp)
                 if t_now is None or (win_t0 is not None and t_now <= win_t0):
                     res.stuck_windows.append(f"sim time did not advance by wall {now - t_start:.0f} s")
                 if not win_moving:
@@ -340,7 +341,7 @@ def run_soak(duration: float, out: Path, seed: int = 1, state_rate: float = 10.0
         after = _counts(client, "after the run")
         last = client.fresh("bodies/states", timeout=0.1) or client.last.get("bodies/states")
         if last is not None and sim_t0 is not None:
-            res.sim_time_s = last.header.stamp.sec + 1e-9 * last.header.stamp.nanosec - sim_t0
+            res.sim_time_s = join_time(last.header.stamp) - sim_t0
         rec.send_signal(signal.SIGINT)
         rec.wait(60)
         def delta(key: str) -> int:

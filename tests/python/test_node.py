@@ -17,6 +17,7 @@ from libcollide_msgs.msg import SpringCommand, ThrusterCommand
 from libcollide_msgs.srv import Kill, Spawn, Step
 from std_srvs.srv import Empty, SetBool
 
+from collide_ros.cdr import join_time
 from collide_ros.testing import SimClient, running_sim
 
 DT = 0.001
@@ -88,7 +89,7 @@ def test_publishes_everything(sim: SimClient) -> None:
     assert all(t.header.frame_id == "world" for t in tf.transforms)
     # headers carry sim time: the stamp of the newest state is within one publish period of /clock
     st = sim.fresh("bodies/states")
-    stamp = st.header.stamp.sec + 1e-9 * st.header.stamp.nanosec
+    stamp = join_time(st.header.stamp)
     assert abs(stamp - (sim.sim_time() or 0.0)) < 1.0
     assert sim.wait_for(lambda: "markers" in sim.last, 10.0)
     bodies = [m for m in sim.last["markers"].markers if m.ns == "bodies"]
@@ -221,8 +222,8 @@ def test_pause_step(sim: SimClient) -> None:
     r1 = sim.call(Step, "step", Step.Request(steps=1))
     r2 = sim.call(Step, "step", Step.Request(steps=250))
     assert r1.success and r2.success
-    a = r1.sim_time.sec + 1e-9 * r1.sim_time.nanosec
-    b = r2.sim_time.sec + 1e-9 * r2.sim_time.nanosec
+    a = join_time(r1.sim_time)
+    b = join_time(r2.sim_time)
     assert b - a == pytest.approx(250 * DT, abs=2e-9)  # exactly 250 steps, stamps rounded to 1 ns
     if t0 is not None:
         assert a - t0 < 0.1  # the clock stood still while paused (one step + what was in flight)
@@ -356,7 +357,7 @@ def test_green_mass_applies_live(sim: SimClient) -> None:
 def _state_at(sim: SimClient, name: str) -> tuple[float, float]:
     msg = sim.fresh("bodies/states")
     i = list(msg.names).index(name)
-    return msg.header.stamp.sec + 1e-9 * msg.header.stamp.nanosec, msg.twists[i].linear.x
+    return join_time(msg.header.stamp), msg.twists[i].linear.x
 
 
 def test_damping_decays_exponentially(sim: SimClient) -> None:
@@ -417,7 +418,7 @@ def test_accepted_commands_are_echoed(sim: SimClient) -> None:
         sim.spin(0.2)
         assert [e.body for e in echoes] == ["block1"]
         assert list(echoes[0].firing) == [True, False]
-        stamp = echoes[0].header.stamp.sec + 1e-9 * echoes[0].header.stamp.nanosec
+        stamp = join_time(echoes[0].header.stamp)
         assert t0 is not None and stamp >= t0  # stamped with the sim time of its first step
     finally:
         sim.node.destroy_subscription(sub)

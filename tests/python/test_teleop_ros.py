@@ -17,6 +17,7 @@ from rclpy.executors import SingleThreadedExecutor
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 from std_srvs.srv import Empty
 
+from collide_ros.cdr import join_time
 from collide_ros.demo import Proc
 
 GIVE_UP = 60.0  # s: only guards against a hung test; never a pass/fail criterion
@@ -38,7 +39,7 @@ class Watch:
         self.reset_cli = self.node.create_client(Empty, "sim/reset")
 
     def _on(self, m: BodyStates) -> None:
-        self.stamp = m.header.stamp.sec + 1e-9 * m.header.stamp.nanosec
+        self.stamp = join_time(m.header.stamp)
         for n, p, t in zip(m.names, m.poses, m.twists):
             yaw = 2.0 * math.atan2(p.orientation.z, p.orientation.w)
             self.last[n] = (p.position.x, p.position.y, yaw, t.linear.x, t.linear.y, t.angular.z)
