@@ -43,6 +43,9 @@ static double tangential_velocity(const double *state, const lc_touch *t)
 
 /* Most alternations between the normal and the friction rows of a small group. */
 #define LC_FRICTION_ROUNDS_SMALL 8
+/* The alternation stops when a round's change grows to this multiple of the previous one's: it is not
+ * converging, and more rounds would only cost solves. */
+#define LC_FRICTION_STALL 1.5
 
 /* Normal and Coulomb friction forces for a group with friction: normal rows (f >= 0) and tangent rows
  * with |f_t| <= mu f_n, the tangent target being to stop sliding within h. Solved by alternating an
@@ -65,7 +68,7 @@ static int solve_with_friction(lc_world *w, const double *state, lc_touch *sub, 
     double *Ann = lc_buf_get(&w->b_cfric, (size_t)m * (size_t)m * sizeof(double));
     double *body = lc_buf_get(&w->b_dacc, (size_t)w->count * 3 * sizeof(double));
     double *b_n, *b_t, *fn, *ft, *bn, *bt, *lo, *hi, *fold, *moved, viol = 0.0;
-    double prev_change = -1.0, prev_rho = -1.0;
+    double prev_change = -1.0, prev_rho = -1.0, inner, change_left = 0.0;
     /* a hundredth of the large groups' tolerance (see solve_large_group): at 2.5e-4 contact_gap / h^2
      * a 1:1000 mass-ratio stack crept 1.6e-8 m in 60 s, at this one 3e-12 m; the settling scene (20
      * blocks, e 0.8, mu 0.5) then cost ~27 ms per step against ~10 ms at the looser one */
@@ -74,6 +77,7 @@ static int solve_with_friction(lc_world *w, const double *state, lc_touch *sub, 
     if (!v || !Ann || !body) return -1;
     b_n = v; b_t = b_n + m; fn = b_t + m; ft = fn + m; bn = ft + m; bt = bn + m;
     lo = bt + m; hi = lo + m; fold = hi + m; moved = fold + m;
+    inner = tol;
     lc_response_matrix(w, sub, m, Ann);
     for (i = 0; i < m; ++i) {
         const lc_touch *ti = &sub[i];
@@ -102,7 +106,7 @@ static int solve_with_friction(lc_world *w, const double *state, lc_touch *sub, 
         /* the tangent rows by MPRGP (sparse_lcp.c): the tangent rows of two corners on one face are
          * parallel, so Att is singular, and projected Gauss-Seidel crept to its sweep cap there at
          * every evaluation (75 % of a settling scene's time) */
-        k = lc_sparse_lcp(w, sub, m, 1, bt, lo, hi, ft, tol, 5 * w->def.lcp_max_iterations, &viol);
+        k = lc_sparse_lcp(w, sub, m, 1, bt, lo, hi, ft, inner, 5 * w->def.lcp_max_iterations, &viol);
         if (k < 0) return -1;
         w->last.contact_solve_iterations += (uint64_t)k;
         if (viol > res.residual) res.residual = viol;
@@ -110,7 +114,20 @@ static int solve_with_friction(lc_world *w, const double *state, lc_touch *sub, 
         for (i = 0; i < m; ++i) fold[i] = ft[i] - fold[i];
         lc_response_rows(w, sub, m, 1, fold, 0, body, moved);
         for (i = 0; i < m; ++i) change = fmax(change, fabs(moved[i]));
-        if (change <= tol) break;
+        change_left = change;
+        if (change <= tol && inner <= tol) break;
+        /* The next tangent solve need only be a tenth as far off as this round's change (an inexact
+         * block Gauss-Seidel): solving every round to tol while the rounds themselves still moved the
+         * forces by ~1 m/s^2 cost ~100 products a round in a pile in motion. The last round, and a
+         * round after one that changed nothing, are solved to tol, so a converged answer is as exact
+         * as before. In a pile in motion the rounds' change stays at ~1-60 m/s^2 and can grow (the
+         * split of the forces among its touches is not unique, and friction at the cone feeds back
+         * into the normal forces): there the alternation stops, and what it still moved is reported
+         * in the residual. Settling scene (20 blocks, e 0.8, mu 0.5): 0.79 -> 0.55 ms per step, 2 614
+         * -> 2 367 impacts in 10 s; stopping as soon as the change stopped shrinking by 5 % a round
+         * made 3 798. */
+        inner = outer + 2 < LC_FRICTION_ROUNDS_SMALL ? fmax(tol, 0.1 * change) : tol;
+        if (prev_change > 0.0 && change >= LC_FRICTION_STALL * prev_change) break;
         /* never in the last round: its forces would leave without a solve that checks them */
         if (prev_change > 0.0 && change < prev_change && outer + 1 < LC_FRICTION_ROUNDS_SMALL) {
             double rho = change / prev_change;
@@ -127,6 +144,8 @@ static int solve_with_friction(lc_world *w, const double *state, lc_touch *sub, 
         }
         prev_change = change;
     }
+    /* what the last round still moved is part of the error (0 when it converged) */
+    if (change_left > res.residual) res.residual = change_left;
     w->last.contact_solves++;
     w->last.resting_contacts += (uint64_t)m;
     if (res.residual > w->last.max_lcp_residual) w->last.max_lcp_residual = res.residual;
@@ -158,11 +177,11 @@ static int solve_large_group(lc_world *w, const double *state, lc_touch *sub, in
 {
     double *v = lc_buf_get(&w->b_group_rows, (size_t)m * 8 * sizeof(double));
     double *body = lc_buf_get(&w->b_dacc, (size_t)w->count * 3 * sizeof(double));
-    double *bn, *bt, *fn, *ft, *lo, *hi, *rhs, *ft_old, tol, viol = 0.0, tviol = 0.0;
+    double *bn, *bt, *fn, *ft, *lo, *hi, *rhs, *ft_old, tol, inner, viol = 0.0, tviol = 0.0, prev_moved = -1.0;
     int i, round, k, products = 0, budget = 5 * w->def.lcp_max_iterations;
     if (v == NULL || body == NULL) return -1;
     bn = v; bt = bn + m; fn = bt + m; ft = fn + m; lo = ft + m; hi = lo + m; rhs = hi + m; ft_old = rhs + m;
-    tol = 2.5e-5 * w->def.contact_gap / (h * h);
+    inner = tol = 2.5e-5 * w->def.contact_gap / (h * h);
     for (i = 0; i < m; ++i) {
         bn[i] = free_acceleration(w, state, &sub[i], acc, sub[i].n) + kv * sub[i].vn +
                 kd * (sub[i].gap - w->def.contact_gap);
@@ -182,7 +201,7 @@ static int solve_large_group(lc_world *w, const double *state, lc_touch *sub, in
             lo[i] = 0.0;
             hi[i] = INFINITY;
         }
-        k = lc_sparse_lcp(w, sub, m, 0, rhs, lo, hi, fn, tol, budget, &viol);
+        k = lc_sparse_lcp(w, sub, m, 0, rhs, lo, hi, fn, inner, budget, &viol);
         if (k < 0) return -1;
         products += k;
         if (!with_friction) break;
@@ -194,7 +213,7 @@ static int solve_large_group(lc_world *w, const double *state, lc_touch *sub, in
             lo[i] = -hi[i];
             ft_old[i] = ft[i];
         }
-        k = lc_sparse_lcp(w, sub, m, 1, rhs, lo, hi, ft, tol, budget, &tviol);
+        k = lc_sparse_lcp(w, sub, m, 1, rhs, lo, hi, ft, inner, budget, &tviol);
         if (k < 0) return -1;
         products += k;
         /* how much the new friction forces change the normal rows' accelerations (ft_old: the change,
@@ -202,8 +221,16 @@ static int solve_large_group(lc_world *w, const double *state, lc_touch *sub, in
         for (i = 0; i < m; ++i) ft_old[i] = ft[i] - ft_old[i];
         lc_response_rows(w, sub, m, 1, ft_old, 0, body, rhs);
         for (i = 0; i < m; ++i) moved = fmax(moved, fabs(rhs[i]));
-        if (moved <= tol) break;
-        if (round + 1 == LC_FRICTION_ROUNDS) viol = fmax(viol, moved);
+        if (moved <= tol && inner <= tol) break;
+        /* not converged in the last round, or diverging (see solve_with_friction): stop, the change
+         * left counted in the residual */
+        if (round + 1 == LC_FRICTION_ROUNDS || (prev_moved > 0.0 && moved >= LC_FRICTION_STALL * prev_moved)) {
+            viol = fmax(viol, moved);
+            break;
+        }
+        prev_moved = moved;
+        /* inexact rounds, as in solve_with_friction: a tenth of this round's change, the last to tol */
+        inner = round + 2 < LC_FRICTION_ROUNDS ? fmax(tol, 0.1 * moved) : tol;
     }
     for (i = 0; i < m; ++i) {
         sub[i].value = fn[i] > 0.0 && isfinite(fn[i]) ? fn[i] : 0.0;
