@@ -41,19 +41,20 @@ static double tangential_velocity(const double *state, const lc_touch *t)
     return lc_dot(lc_tangent_of(t->n), lc_sub(va, vb));
 }
 
-/* The force tolerance of a group: tol while every touch of the group moves slower than
- * restitution_threshold and 100 resting_speed (1 cm/s by default), which is what keeps a resting pile
- * from creeping over minutes; in a group in motion, 1e-4 of its fastest touch's speed per step
- * (v / h), so that a force error moves a point by at most 5e-5 of the distance that touch covers in
- * the step. In a pile in motion the tight tolerance cost the budget of every solve (MPRGP's normal
- * rows stalled at 1e-6-1e-3 m/s^2 after 1 000 products, the rows between side-by-side boxes the
- * slowest): a 5 kg box dropped into a frictional base-12 pyramid took 28 s of CPU for the step of
- * the impact, 2.8 s with this (bench/repro/drop_into_pyramid.py). The speed threshold keeps a slow
- * creep (a frictionless pile drifting at 1e-6 m/s) from loosening its own tolerance. */
+/* The force tolerance of a group: tol while every touch of the group moves slower than 10
+ * resting_speed (1 mm/s by default), which is what keeps a resting pile from creeping over minutes;
+ * in a group in motion, 1e-4 of its fastest touch's speed per step (v / h), so that a force error
+ * moves a point by at most 5e-5 of the distance that touch covers in the step. In a pile in motion
+ * the tight tolerance cost the budget of every solve (MPRGP's normal rows stalled at 1e-6-1e-3 m/s^2
+ * after 1 000 products, the rows between side-by-side boxes the slowest): a 5 kg box dropped into a
+ * frictional base-12 pyramid took 28 s of CPU for the step of the impact, 2.8 s with this
+ * (bench/repro/drop_into_pyramid.py). With the threshold at 1 cm/s the pile's slow settling after
+ * the impact (steps 41-77) took 820 s, at 1 mm/s 161 s. The threshold keeps a slow creep (a
+ * frictionless pile drifting at 1e-6 m/s) from loosening its own tolerance. */
 #define LC_MOTION_TOLERANCE 1e-4
 static double group_tolerance(const lc_world *w, const double *state, const lc_touch *t, int m, double tol, double h)
 {
-    double vmax = 0.0, motion = fmax(w->def.restitution_threshold, 100.0 * w->def.resting_speed);
+    double vmax = 0.0, motion = 10.0 * w->def.resting_speed;
     int i;
     for (i = 0; i < m; ++i) vmax = fmax(vmax, fmax(fabs(t[i].vn), fabs(tangential_velocity(state, &t[i]))));
     return vmax > motion ? fmax(tol, LC_MOTION_TOLERANCE * vmax / h) : tol;
