@@ -5,6 +5,7 @@
  *   sc_def_zero_g()                    - default settings with gravity 0
  *   sc_box(w, width, height, x, y, angle, vx, vy, omega, mass, e)  - add a dynamic w x h rectangle
  *   sc_static_box(w, width, height, x, y, e)                      - add a static rectangle
+ *   sc_pyramid(w, base, mu, ids)       - Box2D's large-pyramid layout of unit boxes (no ground)
  *   sc_poly(w, verts, n, x, y, angle, mass)                        - add a dynamic polygon
  *   sc_row(w, id)                      - pointer to a body's 6 state doubles (x, y, angle, vx, vy, omega)
  *   sc_mass(w, id), sc_inertia(w, id)
@@ -93,6 +94,25 @@ static inline lc_body_id sc_static_box(lc_world *w, double width, double height,
     bd.position.y = y;
     bd.elasticity = e;
     return sc_add(w, &bd, "static box");
+}
+
+/* Box2D's "large pyramid" layout (bench/scenes.py's pyramid): rows of 1 m, 1 kg boxes (e 0, friction
+ * mu) touching side by side, row i (from 0) at y = 0.5 + i on row i - 1, the bottom row on y = 0,
+ * centred on x = 0. The ground is the caller's. Writes the ids to ids when not NULL (base (base + 1) / 2
+ * of them, row by row) and returns their count. */
+static inline int sc_pyramid(lc_world *w, int base, double mu, lc_body_id *ids)
+{
+    int i, j, n = 0;
+    for (i = 0; i < base; ++i)
+        for (j = i; j < base; ++j) {
+            lc_body_id id = sc_box(w, 1.0, 1.0, (i + 1.0) * 0.5 + (j - i) * 1.0 - 0.5 * base, 0.5 + i * 1.0, 0.0, 0.0,
+                                   0.0, 0.0, 1.0, 0.0);
+            lc_status s = lc_body_set_material(w, id, 0.0, mu);
+            CHECK(s == LC_OK, "set_material(0, %g) -> %s", mu, lc_status_string(s));
+            if (ids) ids[n] = id;
+            n++;
+        }
+    return n;
 }
 
 static inline lc_body_id sc_poly(lc_world *w, const lc_vec2 *verts, int n, double x, double y, double angle,

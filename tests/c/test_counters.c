@@ -294,18 +294,13 @@ static void pile_in_motion(void)
     lc_world *w;
     lc_counters tot;
     lc_body_id ground, heavy;
-    int i, j, k, ok = 1;
+    int k, ok = 1;
     const int base = 4;
     d.gravity.x = 0.0;
     d.gravity.y = -10.0;
     w = sc_world(&d);
     if (!w) return;
-    for (i = 0; i < base; ++i)
-        for (j = i; j < base; ++j) {
-            lc_body_id id = sc_box(w, 1.0, 1.0, (i + 1.0) * 0.5 + (j - i) * 1.0 - 0.5 * base, 0.5 + i * 1.0, 0.0, 0.0,
-                                   0.0, 0.0, 1.0, 0.0);
-            lc_body_set_material(w, id, 0.0, 0.6);
-        }
+    sc_pyramid(w, base, 0.6, NULL);
     ground = sc_static_box(w, 2.0 * base + 20.0, 1.0, 0.0, -0.5, 0.5);
     lc_body_set_material(w, ground, 0.5, 0.6);
     heavy = sc_box(w, 1.0, 1.0, 0.3, base + 2.0, 0.0, 0.0, -8.0, 1.0, 5.0, 0.5);

@@ -47,7 +47,7 @@ static void pyramid(double mu, const char *label)
     double x0[NBOX], y0[NBOX], max_dx = 0, max_dy = 0, max_tilt = 0, max_v = 0, max_w = 0, t_v = 0, fsum = 0;
     double top_dx = 0, top_dy = 0, etol;
     const double box[4] = {-30.0, -1.0, 30.0, 30.0};
-    int i, j, k, nb = 0, nc, n_ground = 0, worst_box = -1;
+    int i, k, nb = 0, nc, n_ground = 0, worst_box = -1;
     const lc_contact *cs;
     hc_mon m;
     d.gravity.x = 0.0;
@@ -55,13 +55,11 @@ static void pyramid(double mu, const char *label)
     w = sc_world(&d);
     if (!w) return;
     ground = hc_static(w, 2.0 * BASE + 20.0, 1.0, 0.0, -0.5, 0.0, mu);
-    for (i = 0; i < BASE; i++)
-        for (j = i; j < BASE; j++) {
-            x0[nb] = (i + 1.0) * 0.5 + (j - i) * 1.0 - 0.5 * BASE;
-            y0[nb] = 0.5 + i * 1.0;
-            b[nb] = hc_box(w, 1.0, 1.0, x0[nb], y0[nb], 0.0, 0, 0, 0, 1.0, 0.0, mu);
-            nb++;
-        }
+    nb = sc_pyramid(w, BASE, mu, b);
+    for (i = 0; i < nb; i++) {
+        x0[i] = sc_row(w, b[i])[0];
+        y0[i] = sc_row(w, b[i])[1];
+    }
     if (!hc_mon_init(&m, w, label, HC_DT, box)) { lc_world_destroy(w); return; }
     m.max_collisions = NBOX;
     for (k = 1; k <= PYR_STEPS; k++) {

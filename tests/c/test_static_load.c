@@ -164,7 +164,7 @@ static void cold_pyramid(void)
     lc_world_def d = lc_default_world_def();
     lc_world *w;
     lc_vec2 v[4];
-    int i, j, k;
+    int k;
     d.gravity = lc_v(0.0, -10.0);
     w = sc_world(&d);
     if (!w) return;
@@ -179,17 +179,7 @@ static void cold_pyramid(void)
         g.friction = 0.6;
         sc_add(w, &g, "ground");
     }
-    lc_make_rectangle(1.0, 1.0, v);
-    for (i = 0; i < base; ++i)
-        for (j = i; j < base; ++j) {
-            lc_body_def b = lc_default_body_def();
-            b.vertices = v;
-            b.vertex_count = 4;
-            b.position = lc_v((i + 1.0) * 0.5 + (j - i) * 1.0 - 0.5 * base, 0.5 + i);
-            b.elasticity = 0.0;
-            b.friction = 0.6;
-            sc_add(w, &b, "box");
-        }
+    sc_pyramid(w, base, 0.6, NULL);
     for (k = 0; k < 3; ++k) {
         lc_counters c;
         lc_status s = lc_world_step(w, 1.0 / 60.0);
