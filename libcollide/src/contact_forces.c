@@ -47,6 +47,14 @@ static double tangential_velocity(const double *state, const lc_touch *t)
  * converging, and more rounds would only cost solves. */
 #define LC_FRICTION_STALL 1.5
 
+/* Tolerance of the next round's solves after round `round` (of `rounds`) changed the forces by
+ * `change`: a tenth of that change (inexact block Gauss-Seidel, see solve_with_friction), never below
+ * tol, and tol itself in the last round. */
+static double next_round_tolerance(double tol, double change, int round, int rounds)
+{
+    return round + 2 < rounds ? fmax(tol, 0.1 * change) : tol;
+}
+
 /* Normal and Coulomb friction forces for a group with friction: normal rows (f >= 0) and tangent rows
  * with |f_t| <= mu f_n, the tangent target being to stop sliding within h. Solved by alternating an
  * exact normal solve (friction held fixed) with a boxed solve of the tangent rows (normal forces held
@@ -68,7 +76,7 @@ static int solve_with_friction(lc_world *w, const double *state, lc_touch *sub, 
     double *Ann = lc_buf_get(&w->b_cfric, (size_t)m * (size_t)m * sizeof(double));
     double *body = lc_buf_get(&w->b_dacc, (size_t)w->count * 3 * sizeof(double));
     double *b_n, *b_t, *fn, *ft, *bn, *bt, *lo, *hi, *fold, *moved, viol = 0.0;
-    double prev_change = -1.0, prev_rho = -1.0, inner, change_left = 0.0;
+    double prev_change = -1.0, prev_rho = -1.0, inner, change = 0.0;
     /* a hundredth of the large groups' tolerance (see solve_large_group): at 2.5e-4 contact_gap / h^2
      * a 1:1000 mass-ratio stack crept 1.6e-8 m in 60 s, at this one 3e-12 m; the settling scene (20
      * blocks, e 0.8, mu 0.5) then cost ~27 ms per step against ~10 ms at the looser one */
@@ -87,8 +95,8 @@ static int solve_with_friction(lc_world *w, const double *state, lc_touch *sub, 
         ft[i] = isfinite(ti->tangent) ? ti->tangent : 0.0;
     }
     for (outer = 0; outer < LC_FRICTION_ROUNDS_SMALL; ++outer) {
-        double change = 0.0;
         int k;
+        change = 0.0;
         lc_response_rows(w, sub, m, 1, ft, 0, body, bn);
         for (i = 0; i < m; ++i) bn[i] += b_n[i];
         lc_lcp_solve(m, Ann, bn, fn, NULL, opt, w->lcp, &res);
@@ -114,7 +122,6 @@ static int solve_with_friction(lc_world *w, const double *state, lc_touch *sub, 
         for (i = 0; i < m; ++i) fold[i] = ft[i] - fold[i];
         lc_response_rows(w, sub, m, 1, fold, 0, body, moved);
         for (i = 0; i < m; ++i) change = fmax(change, fabs(moved[i]));
-        change_left = change;
         if (change <= tol && inner <= tol) break;
         /* The next tangent solve need only be a tenth as far off as this round's change (an inexact
          * block Gauss-Seidel): solving every round to tol while the rounds themselves still moved the
@@ -126,7 +133,7 @@ static int solve_with_friction(lc_world *w, const double *state, lc_touch *sub, 
          * in the residual. Settling scene (20 blocks, e 0.8, mu 0.5): 0.79 -> 0.55 ms per step, 2 614
          * -> 2 367 impacts in 10 s; stopping as soon as the change stopped shrinking by 5 % a round
          * made 3 798. */
-        inner = outer + 2 < LC_FRICTION_ROUNDS_SMALL ? fmax(tol, 0.1 * change) : tol;
+        inner = next_round_tolerance(tol, change, outer, LC_FRICTION_ROUNDS_SMALL);
         if (prev_change > 0.0 && change >= LC_FRICTION_STALL * prev_change) break;
         /* never in the last round: its forces would leave without a solve that checks them */
         if (prev_change > 0.0 && change < prev_change && outer + 1 < LC_FRICTION_ROUNDS_SMALL) {
@@ -144,8 +151,8 @@ static int solve_with_friction(lc_world *w, const double *state, lc_touch *sub, 
         }
         prev_change = change;
     }
-    /* what the last round still moved is part of the error (0 when it converged) */
-    if (change_left > res.residual) res.residual = change_left;
+    /* what the last round still moved is part of the error (at most tol when it converged) */
+    if (change > res.residual) res.residual = change;
     w->last.contact_solves++;
     w->last.resting_contacts += (uint64_t)m;
     if (res.residual > w->last.max_lcp_residual) w->last.max_lcp_residual = res.residual;
@@ -229,8 +236,7 @@ static int solve_large_group(lc_world *w, const double *state, lc_touch *sub, in
             break;
         }
         prev_moved = moved;
-        /* inexact rounds, as in solve_with_friction: a tenth of this round's change, the last to tol */
-        inner = round + 2 < LC_FRICTION_ROUNDS ? fmax(tol, 0.1 * moved) : tol;
+        inner = next_round_tolerance(tol, moved, round, LC_FRICTION_ROUNDS);
     }
     for (i = 0; i < m; ++i) {
         sub[i].value = fn[i] > 0.0 && isfinite(fn[i]) ? fn[i] : 0.0;
