@@ -41,6 +41,32 @@ static double tangential_velocity(const double *state, const lc_touch *t)
     return lc_dot(lc_tangent_of(t->n), lc_sub(va, vb));
 }
 
+/* The force tolerance of a group: tol while every touch of the group moves slower than 10
+ * resting_speed (1 mm/s by default), which is what keeps a resting pile from creeping over minutes;
+ * in a group in motion, 1e-4 of its fastest touch's speed per step (v / h), so that a force error
+ * moves a point by at most 5e-5 of the distance that touch covers in the step, but never looser
+ * than 1e-3 of gravity's acceleration (no loosening at g = 0).
+ * Why: in a pile in motion the tight tolerance cost the budget of every solve (MPRGP's normal rows
+ * stalled at 1e-6-1e-3 m/s^2 after 1 000 products, the rows between side-by-side boxes the
+ * slowest); a 5 kg box dropped into a frictional base-12 pyramid (bench/repro/drop_into_pyramid.py)
+ * was undone at the serial cap in step 12, and goes through its first 20 steps in 51 s of CPU with
+ * this (34 s without the ceiling, 70 s with a ceiling of 10 contact_gap / h^2).
+ * The speed threshold keeps a slow creep (a frictionless pile drifting at 1e-6 m/s) from loosening
+ * its own tolerance: at 1 cm/s the pile's slow settling after that impact took 820 s, at 1 mm/s
+ * 161 s. The ceiling bounds what a fast body can loosen: a 1e-11 m sliver at 1e6 m/s (dt 1e-3)
+ * made the tolerance 1e5 m/s^2 and a step ran to LC_MAX_FORCE_EVALUATIONS_PER_STEP (docs/
+ * hardening.md, finding 30); with the ceiling the input takes 0.08 s. */
+#define LC_MOTION_TOLERANCE 1e-4
+#define LC_MOTION_TOLERANCE_CEILING 1e-3
+static double group_tolerance(const lc_world *w, const double *state, const lc_touch *t, int m, double tol, double h)
+{
+    double vmax = 0.0, motion = 10.0 * w->def.resting_speed;
+    double ceiling = LC_MOTION_TOLERANCE_CEILING * sqrt(w->def.gravity.x * w->def.gravity.x + w->def.gravity.y * w->def.gravity.y);
+    int i;
+    for (i = 0; i < m; ++i) vmax = fmax(vmax, fmax(fabs(t[i].vn), fabs(tangential_velocity(state, &t[i]))));
+    return vmax > motion ? fmax(tol, fmin(ceiling, LC_MOTION_TOLERANCE * vmax / h)) : tol;
+}
+
 /* Most alternations between the normal and the friction rows of a small group. */
 #define LC_FRICTION_ROUNDS_SMALL 8
 /* The alternation stops when a round's change grows to this multiple of the previous one's: it is not
@@ -80,7 +106,7 @@ static int solve_with_friction(lc_world *w, const double *state, lc_touch *sub, 
     /* a hundredth of the large groups' tolerance (see solve_large_group): at 2.5e-4 contact_gap / h^2
      * a 1:1000 mass-ratio stack crept 1.6e-8 m in 60 s, at this one 3e-12 m; the settling scene (20
      * blocks, e 0.8, mu 0.5) then cost ~27 ms per step against ~10 ms at the looser one */
-    double tol = 2.5e-7 * w->def.contact_gap / (h * h);
+    double tol = group_tolerance(w, state, sub, m, 2.5e-7 * w->def.contact_gap / (h * h), h);
     lc_lcp_result res;
     if (!v || !Ann || !body) return -1;
     b_n = v; b_t = b_n + m; fn = b_t + m; ft = fn + m; bn = ft + m; bt = bn + m;
@@ -188,7 +214,7 @@ static int solve_large_group(lc_world *w, const double *state, lc_touch *sub, in
     int i, round, k, products = 0, budget = 5 * w->def.lcp_max_iterations;
     if (v == NULL || body == NULL) return -1;
     bn = v; bt = bn + m; fn = bt + m; ft = fn + m; lo = ft + m; hi = lo + m; rhs = hi + m; ft_old = rhs + m;
-    inner = tol = 2.5e-5 * w->def.contact_gap / (h * h);
+    inner = tol = group_tolerance(w, state, sub, m, 2.5e-5 * w->def.contact_gap / (h * h), h);
     for (i = 0; i < m; ++i) {
         bn[i] = free_acceleration(w, state, &sub[i], acc, sub[i].n) + kv * sub[i].vn +
                 kd * (sub[i].gap - w->def.contact_gap);
