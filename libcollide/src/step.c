@@ -13,8 +13,16 @@
  * impulse passes. A 210-box pyramid needs ~30 evaluations per step and the seed scene none; these
  * are reached only by inputs such as a 1e6 kg and a 1e-300 kg body at 1e6 m/s, or a stiff spring
  * anchored 1e6 m away, which would otherwise spend seconds on one step before failing anyway. */
-#define LC_MAX_FORCE_EVALUATIONS_PER_STEP 500000u
-#define LC_MAX_SERIAL_ITERATIONS_PER_STEP 50000u
+#ifndef LC_MAX_FORCE_EVALUATIONS_PER_STEP
+#define LC_MAX_FORCE_EVALUATIONS_PER_STEP 500000
+#endif
+#ifndef LC_MAX_SERIAL_ITERATIONS_PER_STEP
+#define LC_MAX_SERIAL_ITERATIONS_PER_STEP 50000
+#endif
+/* The caps can be lowered at build time (-DLC_MAX_...=N, a plain decimal number): fuzz/run --engine-cap
+ * does so, so that the fuzzer does not spend seconds on each input that ends at a cap anyway. */
+#define LC_STRINGIFY_(x) #x
+#define LC_STRINGIFY(x) LC_STRINGIFY_(x)
 
 /* The touches the last step's projection found at the state it ended in, moved into buf, if this
  * gather is at that same state (-1: none kept, or something changed since). The first gather of a
@@ -900,8 +908,9 @@ lc_status lc_world_step(lc_world *w, double dt)
         if (w->last.force_evaluations > LC_MAX_FORCE_EVALUATIONS_PER_STEP ||
             w->last.serial_iterations > LC_MAX_SERIAL_ITERATIONS_PER_STEP)
             return step_failed(w, backup, time0, LC_ERR_NUMERIC,
-                               "the step needed more than 500000 force evaluations or 50000 serial impulse passes "
-                               "(stiff forces or extreme speeds?)");
+                               "the step needed more than " LC_STRINGIFY(LC_MAX_FORCE_EVALUATIONS_PER_STEP)
+                               " force evaluations or " LC_STRINGIFY(LC_MAX_SERIAL_ITERATIONS_PER_STEP)
+                               " serial impulse passes (stiff forces or extreme speeds?)");
         /* After an impact in free flight (nothing resting, no spring between bodies, the same trial
          * end), only the bodies of that impact move differently: every other body keeps its trial
          * path to the previous trial's end, and the crossings found between two such bodies stay
