@@ -746,6 +746,19 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     for (k = 0; k < MAX_COMMANDS && !fz_done(&in) && fz_may_step(&c); ++k) fz_command(&in, &c);
     if (c.steps == 0) fz_step(&in, &c); /* every input steps at least once */
     lc_world_destroy(c.w);
+#ifdef FZ_REPLAY_MAIN
+    {
+        /* a regression for slowness carries its own bound on the input's whole work (the replayer sets
+         * FZ_WORK_BOUND from fuzz/corpus/step-work-bounds.txt): the per-step bounds above are far above
+         * what such inputs do once fixed, so without it their regression could not fail */
+        const char *bound = getenv("FZ_WORK_BOUND");
+        char msg[96];
+        snprintf(msg, sizeof msg, "%llu units (bound %s)", c.work, bound ? bound : "none");
+        if (fz_trace()) fprintf(stderr, "fuzz_step: work of the input: %s\n", msg);
+        if (bound != NULL && c.work > strtoull(bound, NULL, 10))
+            fz_fail("the input took more work than its bound in step-work-bounds.txt", msg);
+    }
+#endif
     return 0;
 }
 
@@ -761,8 +774,24 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
  * them (findings) took up to 41 s under ASan on the 2-core machine at load 6, so 120 s is a hang. */
 #define FZ_REPLAY_SECONDS 120
 
-static int fz_replay_file(const char *path)
+/* The work bound of an input (0: none) from the lines "name bound" of a bounds file, by base name. */
+static unsigned long long fz_work_bound(const char *bounds_file, const char *path)
 {
+    FILE *f;
+    char line[512], name[256];
+    unsigned long long bound, found = 0;
+    const char *base = strrchr(path, '/');
+    base = base ? base + 1 : path;
+    if (bounds_file == NULL || (f = fopen(bounds_file, "r")) == NULL) return 0;
+    while (fgets(line, sizeof line, f) != NULL)
+        if (line[0] != '#' && sscanf(line, "%255s %llu", name, &bound) == 2 && strcmp(name, base) == 0) found = bound;
+    fclose(f);
+    return found;
+}
+
+static int fz_replay_file(const char *path, const char *bounds_file)
+{
+    unsigned long long bound = fz_work_bound(bounds_file, path);
     FILE *f;
     uint8_t *buf;
     long n;
@@ -782,6 +811,11 @@ static int fz_replay_file(const char *path)
         return 1;
     }
     alarm(FZ_REPLAY_SECONDS);
+    if (bound > 0) {
+        char b[32];
+        snprintf(b, sizeof b, "%llu", bound);
+        if (setenv("FZ_WORK_BOUND", b, 1) != 0) _exit(2);
+    }
     f = fopen(path, "rb");
     if (f == NULL) { fprintf(stderr, "fuzz_step: cannot open %s\n", path); _exit(2); }
     if (fseek(f, 0, SEEK_END) != 0 || (n = ftell(f)) < 0 || fseek(f, 0, SEEK_SET) != 0) _exit(2);
@@ -793,10 +827,19 @@ static int fz_replay_file(const char *path)
     exit(0); /* exit, not _exit: sanitizer leak checks run at exit */
 }
 
+/* fuzz_step_replay [--work-bounds FILE] PATH...: each file, or each file of each directory */
 int main(int argc, char **argv)
 {
-    int i, files = 0, bad = 0;
-    for (i = 1; i < argc; ++i) {
+    int i = 1, files = 0, bad = 0;
+    const char *bounds_file = NULL;
+    if (argc > 2 && strcmp(argv[1], "--work-bounds") == 0) {
+        FILE *f = fopen(argv[2], "r");
+        if (f == NULL) { fprintf(stderr, "fuzz_step: cannot open %s\n", argv[2]); return 1; }
+        fclose(f);
+        bounds_file = argv[2];
+        i = 3;
+    }
+    for (; i < argc; ++i) {
         struct stat st;
         if (stat(argv[i], &st) != 0) { fprintf(stderr, "fuzz_step: no such path %s\n", argv[i]); return 1; }
         if (S_ISDIR(st.st_mode)) {
@@ -807,12 +850,12 @@ int main(int argc, char **argv)
             while ((e = readdir(dir)) != NULL) {
                 if (e->d_name[0] == '.') continue;
                 snprintf(path, sizeof path, "%s/%s", argv[i], e->d_name);
-                bad += fz_replay_file(path);
+                bad += fz_replay_file(path, bounds_file);
                 files++;
             }
             closedir(dir);
         } else {
-            bad += fz_replay_file(argv[i]);
+            bad += fz_replay_file(argv[i], bounds_file);
             files++;
         }
     }
