@@ -19,7 +19,15 @@
  *     than m g contact_distance, and at 60 s it is at rest (|v|, |omega| <= 1e-6). Frictionless, the
  *     contact normals are horizontal, so until it lands it is in free fall with x, angle unchanged:
  *     y(t) = 3 - g t^2 / 2 to 1e-9 m (closed-form flight; the first 0.5 s, before the lowest corner
- *     can reach the floor at t = sqrt(2 (3 - 0.4665) / g) = 0.719 s). */
+ *     can reach the floor at t = sqrt(2 (3 - 0.4665) / g) = 0.719 s).
+ * (2b) a hopping block: one block of (2) standing on its 0.5 m end, rocking from corner to corner at
+ *     ~1 cm/s while drifting sideways (the state a run of (2) reached at 10 s, to 17 digits), e 0.8,
+ *     mu 0.5, alone on the floor. Friction that pushed a slipping corner along its slip gave it
+ *     ~1.5e-4 J per rock, and it hopped on for 26 s (forever alone). Asserted: no impact in the last
+ *     5 of 10 s, at rest at 10 s (|v|, |omega| <= 1e-6), and the energy never above its start by more
+ *     than m g |v0| dt = 2.3e-3 J, the work of a weight-sized force on a corner parting at the
+ *     block's speed for one step: a touch resting when an interval begins keeps its force while it
+ *     parts within that interval (step.c gather_resting, docs/physics.md). */
 #include "check.h"
 #include "scenes.h"
 #include "test_hard_common.h"
@@ -149,8 +157,48 @@ static void wedged(double mu, const char *label)
     lc_world_destroy(w);
 }
 
+static void hopping(void)
+{
+    const double g = 9.8, mu = 0.5, e = 0.8, dt = HC_DT;
+    const double v0[3] = {0.0050645411367954349, 0.012807217399986076, 0.034056703829182994};
+    lc_world_def d = lc_default_world_def();
+    lc_world *w;
+    lc_body_id blk;
+    lc_counters c;
+    hc_mon m;
+    const double box[4] = {-5.0, 0.0, 5.0, 10.0};
+    const char *label = "hopping block, e = 0.8, mu = 0.5";
+    double vmax, wmax, gain_tol;
+    unsigned long long late = 0;
+    int k;
+    d.gravity.x = 0.0;
+    d.gravity.y = -g;
+    w = sc_world(&d);
+    if (!w) return;
+    blk = hc_box(w, 1.0, 0.5, 0.0, 0.5000039247682968, 1.5707997254196675, v0[0], v0[1], v0[2], 1.0, e, mu);
+    hc_static(w, 10.0, 1.0, 0.0, -0.5, e, mu);
+    (void)blk;
+    if (!hc_mon_init(&m, w, label, dt, box)) { lc_world_destroy(w); return; }
+    for (k = 1; k <= 600; k++) {
+        if (!hc_step(&m)) break;
+        lc_world_get_counters(w, &c, NULL);
+        if (k > 300) late += c.collisions;
+    }
+    hc_finish(&m, 600);
+    hc_max_speeds(w, &vmax, &wmax);
+    gain_tol = 1.0 * g * sqrt(v0[0] * v0[0] + v0[1] * v0[1]) * dt;
+    printf("%s: impacts in the last 5 s %llu, max |v| %.3e, |omega| %.3e at 10 s, max energy gain %.3e J "
+           "(bound %.3e)\n", label, late, vmax, wmax, m.max_gain, gain_tol);
+    CHECK(late == 0, "%s: still hopping: %llu impacts in the last 5 s", label, late);
+    CHECK(vmax <= 1e-6 && wmax <= 1e-6, "%s: not at rest at 10 s: |v| %.3e, |omega| %.3e", label, vmax, wmax);
+    CHECK(m.max_gain <= gain_tol, "%s: energy rose by %.3e J", label, m.max_gain);
+    hc_mon_free(&m);
+    lc_world_destroy(w);
+}
+
 int main(void)
 {
+    hopping();
     settling(0.5, "settling 20 blocks, e = 0.8, mu = 0.5");
     wedged(0.6, "wedged 30 deg, mu = 0.6");
     wedged(0.0, "wedged 30 deg, frictionless");
