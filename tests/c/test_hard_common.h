@@ -287,4 +287,28 @@ static inline void hc_walls(lc_world *w, double xmin, double ymin, double xmax, 
     for (i = 0; i < 4; i++) lc_body_set_material(w, out[i], e, mu);
 }
 
+/* The settling scene's layout (bench settling(), layout `seed`): walls bounding [0, 10]^2 and 20 blocks
+ * 1 m x 0.5 m of 1 kg in random cells of a 5 x 5 grid with random angles, velocities and spins, all with
+ * material (e, mu); the blocks' ids in out[20]. */
+static inline void hc_settling_layout(lc_world *w, uint64_t seed, double e, double mu, lc_body_id out[20])
+{
+    lc_body_id walls[4];
+    sc_rng rng;
+    int cells[25], i;
+    rng.s = seed;
+    hc_walls(w, 0.0, 0.0, 10.0, 10.0, e, mu, walls);
+    for (i = 0; i < 25; i++) cells[i] = i;
+    for (i = 24; i > 0; i--) {
+        int j = (int)(sc_rand(&rng) * (i + 1)), t = cells[i];
+        cells[i] = cells[j];
+        cells[j] = t;
+    }
+    for (i = 0; i < 20; i++) {
+        double x = 1.0 + 2.0 * (cells[i] % 5), y = 1.0 + 2.0 * (cells[i] / 5);
+        double a = sc_uniform(&rng, 0.0, SC_PI), vx = sc_uniform(&rng, -3, 3), vy = sc_uniform(&rng, -3, 3);
+        double om = sc_uniform(&rng, -2, 2);
+        out[i] = hc_box(w, 1.0, 0.5, x, y, a, vx, vy, om, 1.0, e, mu);
+    }
+}
+
 #endif /* LC_TESTS_HARD_COMMON_H */

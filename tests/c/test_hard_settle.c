@@ -38,9 +38,8 @@ static void settling(double mu, const char *label)
     lc_world_def d = lc_default_world_def();
     lc_world *w;
     lc_world_def got;
-    lc_body_id walls[4], b[20];
-    int cells[25], i, k;
-    sc_rng rng = {1u};
+    lc_body_id b[20];
+    int i, k;
     hc_mon m;
     const double box[4] = {0.0, 0.0, 10.0, 10.0};
     double pos[20][3], max_move = 0, ke_end, gain_tol;
@@ -49,19 +48,7 @@ static void settling(double mu, const char *label)
     w = sc_world(&d);
     if (!w) return;
     lc_world_get_def(w, &got);
-    hc_walls(w, 0.0, 0.0, 10.0, 10.0, e, mu, walls);
-    for (i = 0; i < 25; i++) cells[i] = i;
-    for (i = 24; i > 0; i--) {
-        int j = (int)(sc_rand(&rng) * (i + 1)), t = cells[i];
-        cells[i] = cells[j];
-        cells[j] = t;
-    }
-    for (i = 0; i < 20; i++) {
-        double x = 1.0 + 2.0 * (cells[i] % 5), y = 1.0 + 2.0 * (cells[i] / 5);
-        double a = sc_uniform(&rng, 0.0, SC_PI), vx = sc_uniform(&rng, -3, 3), vy = sc_uniform(&rng, -3, 3);
-        double om = sc_uniform(&rng, -2, 2);
-        b[i] = hc_box(w, 1.0, 0.5, x, y, a, vx, vy, om, 1.0, e, mu);
-    }
+    hc_settling_layout(w, 1u, e, mu, b);
     if (!hc_mon_init(&m, w, label, HC_DT, box)) { lc_world_destroy(w); return; }
     m.max_collisions = 200000; /* settling has a few thousand impacts (printed) */
     for (k = 1; k <= HC_STEPS; k++) {
