@@ -105,98 +105,8 @@ static int advance_quiet(lc_world *w, const double *s0, double h, const int *iro
     return 1;
 }
 
-/* What the contact forces of a touch depend on besides the state: which points touch, and friction. */
-typedef struct fsal_key { int a, b, vertex, edge; double friction; } fsal_key;
-
-static int same_keys(const fsal_key *k, const lc_touch *t, int nt)
-{
-    int i;
-    for (i = 0; i < nt; ++i)
-        if (k[i].a != t[i].a || k[i].b != t[i].b || k[i].vertex != t[i].vertex || k[i].edge != t[i].edge ||
-            memcmp(&k[i].friction, &t[i].friction, sizeof(double)) != 0)
-            return 0;
-    return 1;
-}
-
-/* A quiet interval ends with an evaluation (k2) at its end, up to h^2 (a1 - a0) / 6 in position and
- * h (a1 - a0) / 2 in velocity, with |a1 - a0| within advance_quiet's tolerance. When the next interval
- * starts exactly where this one ended (no impact, no projection, no API call in between), that
- * evaluation is its start acceleration (first same as last): one contact solve per quiet interval
- * instead of two (a resting base-20 pyramid: 2.00 -> 1.04 force evaluations per step). The applied
- * accelerations (springs, damping) are evaluated again at the true end and swapped in, so only the
- * contact forces' part is reused, off by the stabilisation's response to those differences: half of
- * advance_quiet's tolerance with velocity stabilisation (kv = 1/h), 7/6 of it with distance too.
- * Only the step's trial intervals chain (lc_integrate_chained); a time-of-impact search must see the
- * same function of time at every evaluation. This keeps the end of a quiet trial interval: */
-static int quiet_end_keep(lc_world *w, const double *tmp, const double *s1, const int *irows, int ni,
-                          const lc_touch *t, int nt, const double *k2)
-{
-    size_t bytes = (size_t)w->count * 6 * sizeof(double);
-    double *st = lc_buf_get(&w->b_fsal_state, bytes);
-    double *acc = lc_buf_get(&w->b_fsal_acc, (size_t)w->count * 3 * sizeof(double));
-    double *app = lc_buf_get(&w->b_fsal_applied, (size_t)w->count * 3 * sizeof(double));
-    int *rows = lc_buf_get(&w->b_fsal_rows, (size_t)ni * sizeof(int));
-    fsal_key *k = lc_buf_get(&w->b_fsal_keys, (size_t)(nt > 0 ? nt : 1) * sizeof(fsal_key));
-    double *at_tmp = lc_buf_get(&w->b_acc, (size_t)w->count * 3 * sizeof(double));
-    int i, j;
-    w->fsal_valid = 0;
-    if (!st || !acc || !app || !rows || !k || !at_tmp) return -1;
-    memcpy(st, s1, bytes);
-    memcpy(rows, irows, (size_t)ni * sizeof(int));
-    lc_applied_accelerations(w, tmp, irows, ni, at_tmp);
-    lc_applied_accelerations(w, s1, irows, ni, app);
-    for (i = 0; i < ni; ++i) {
-        int r = irows[i];
-        for (j = 0; j < 3; ++j) acc[r * 3 + j] = k2[r * 6 + 3 + j] - at_tmp[r * 3 + j] + app[r * 3 + j];
-    }
-    for (i = 0; i < nt; ++i) {
-        k[i].a = t[i].a;
-        k[i].b = t[i].b;
-        k[i].vertex = t[i].vertex;
-        k[i].edge = t[i].edge;
-        k[i].friction = t[i].friction;
-    }
-    w->fsal_rows = ni;
-    w->fsal_touches = nt;
-    w->fsal_count = w->count;
-    w->fsal_edits = w->edits;
-    w->fsal_dt = w->step_dt;
-    memcpy(&w->fsal_def, &w->def, sizeof w->def);
-    w->fsal_valid = 1;
-    return 0;
-}
-
-/* 1 when the kept end of the last quiet interval is this interval's start (same state bit for bit,
- * same rows, touches, world settings and applied accelerations): k1 is then filled from it. */
-static int quiet_start(lc_world *w, const double *s0, const int *irows, int ni, const lc_touch *t, int nt,
-                       double *acc, double *k1)
-{
-    const double *app = (const double *)w->b_fsal_applied.p, *kept = (const double *)w->b_fsal_acc.p;
-    int i, j;
-    if (!w->fsal_valid) return 0;
-    w->fsal_valid = 0;   /* one use */
-    if (w->fsal_count != w->count || w->fsal_edits != w->edits || w->fsal_rows != ni || w->fsal_touches != nt ||
-        memcmp(&w->fsal_dt, &w->step_dt, sizeof(double)) != 0 || memcmp(&w->fsal_def, &w->def, sizeof w->def) != 0 ||
-        memcmp(w->b_fsal_rows.p, irows, (size_t)ni * sizeof(int)) != 0 ||
-        memcmp(w->b_fsal_state.p, s0, (size_t)w->count * 6 * sizeof(double)) != 0 ||
-        !same_keys((const fsal_key *)w->b_fsal_keys.p, t, nt))
-        return 0;
-    /* thrusters, external forces, gravity or spring targets changed by the API since */
-    lc_applied_accelerations(w, s0, irows, ni, acc);
-    for (i = 0; i < ni; ++i)
-        if (memcmp(&acc[irows[i] * 3], &app[irows[i] * 3], 3 * sizeof(double)) != 0) return 0;
-    for (i = 0; i < ni; ++i) {
-        int r = irows[i];
-        for (j = 0; j < 3; ++j) {
-            k1[r * 6 + j] = s0[r * 6 + 3 + j];
-            k1[r * 6 + 3 + j] = kept[r * 3 + j];
-        }
-    }
-    return 1;
-}
-
-static int integrate(lc_world *w, const double *s0, double h, const int *rows, int nrows, lc_touch *touches,
-                     int nt, double *s1, int chain)
+int lc_integrate(lc_world *w, const double *s0, double h, const int *rows, int nrows,
+                 lc_touch *touches, int nt, double *s1)
 {
     size_t bytes = (size_t)w->count * 6 * sizeof(double);
     int *flags, *irows, ni = 0, i;
@@ -229,15 +139,6 @@ static int integrate(lc_world *w, const double *s0, double h, const int *rows, i
     if (!tmp || !k1 || !k2 || !k3 || !k4) return -1;
     /* tmp holds every row (others constant during the step) so springs and contacts can read them */
     memcpy(tmp, s0, bytes);
-    if (chain && w->def.integrator == LC_INTEGRATOR_RK4 && nt > 0 && rows_quiet(w, s0, irows, ni) &&
-        quiet_start(w, s0, irows, ni, touches, nt, acc, k1)) {
-        int q = advance_quiet(w, s0, h, irows, ni, touches, nt, acc, tmp, k1, k2, s1);
-        if (q < 0) return -1;
-        if (q > 0) return quiet_end_keep(w, tmp, s1, irows, ni, touches, nt, k2);
-        /* the interval is not quiet after all: from a fresh k1, as without the kept end */
-        memcpy(tmp, s0, bytes);
-    }
-    if (chain) w->fsal_valid = 0;
     if (derivative(w, s0, irows, ni, touches, nt, acc, k1)) return -1;
     switch (w->def.integrator) {
     case LC_INTEGRATOR_EULER:
@@ -252,8 +153,7 @@ static int integrate(lc_world *w, const double *s0, double h, const int *rows, i
     default:
         if (nt > 0 && rows_quiet(w, s0, irows, ni)) {
             int q = advance_quiet(w, s0, h, irows, ni, touches, nt, acc, tmp, k1, k2, s1);
-            if (q < 0) return -1;
-            if (q > 0) return chain ? quiet_end_keep(w, tmp, s1, irows, ni, touches, nt, k2) : 0;
+            if (q != 0) return q < 0 ? -1 : 0;
         }
         axpy_rows(tmp, s0, 0.5 * h, k1, irows, ni);
         if (derivative(w, tmp, irows, ni, touches, nt, acc, k2)) return -1;
@@ -271,16 +171,4 @@ static int integrate(lc_world *w, const double *s0, double h, const int *rows, i
     /* the last evaluation's contact forces describe the end of the interval closely enough for output;
      * re-evaluate at s1 so reported forces belong to the reported state */
     return 0;
-}
-
-int lc_integrate(lc_world *w, const double *s0, double h, const int *rows, int nrows,
-                 lc_touch *touches, int nt, double *s1)
-{
-    return integrate(w, s0, h, rows, nrows, touches, nt, s1, 0);
-}
-
-int lc_integrate_chained(lc_world *w, const double *s0, double h, const int *rows, int nrows,
-                         lc_touch *touches, int nt, double *s1)
-{
-    return integrate(w, s0, h, rows, nrows, touches, nt, s1, 1);
 }

@@ -922,7 +922,7 @@ lc_status lc_world_step(lc_world *w, double dt)
             if (lc_integrate(w, s0, trial, drows, ndirty, rest, 0, scratch) != 0) goto oom;
             for (i = 0; i < ndirty; ++i) memcpy(&s1[drows[i] * 6], &scratch[drows[i] * 6], 6 * sizeof(double));
         } else {
-            if (lc_integrate_chained(w, s0, trial, rows, nrows, rest, nrest, s1) != 0) goto oom;
+            if (lc_integrate(w, s0, trial, rows, nrows, rest, nrest, s1) != 0) goto oom;
         }
         lc_stage_end(w, &w->last.time_integration, ts);
         for (i = 0; i < nrows; ++i) {

@@ -217,7 +217,6 @@ void lc_world_destroy(lc_world *w)
     lc_buf_free(&w->b_flags); lc_buf_free(&w->b_mat); lc_buf_free(&w->b_vec); lc_buf_free(&w->b_vec2);
     lc_buf_free(&w->b_step_scratch); lc_buf_free(&w->b_sample0); lc_buf_free(&w->b_sample1); lc_buf_free(&w->b_swept); lc_buf_free(&w->b_end_touches); lc_buf_free(&w->b_end_state); lc_buf_free(&w->b_marked_rows); lc_buf_free(&w->b_rkeys); lc_buf_free(&w->b_emark); lc_buf_free(&w->b_isl); lc_buf_free(&w->b_isl_touch); lc_buf_free(&w->b_isl_pick); lc_buf_free(&w->b_isl_pick_touch); lc_buf_free(&w->b_sparse); lc_buf_free(&w->b_sparse_body); lc_buf_free(&w->b_group_rows); lc_buf_free(&w->b_load); lc_buf_free(&w->b_load_graph); lc_buf_free(&w->b_dirty); lc_buf_free(&w->b_drows); lc_buf_free(&w->b_group); lc_buf_free(&w->b_fric); lc_buf_free(&w->b_cfric); lc_buf_free(&w->b_order); lc_buf_free(&w->b_cross);
     lc_buf_free(&w->b_impact); lc_buf_free(&w->b_irows); lc_buf_free(&w->b_coupled); lc_buf_free(&w->b_dacc); lc_buf_free(&w->b_diag); lc_buf_free(&w->b_warm); lc_buf_free(&w->b_hash);
-    lc_buf_free(&w->b_fsal_state); lc_buf_free(&w->b_fsal_acc); lc_buf_free(&w->b_fsal_applied); lc_buf_free(&w->b_fsal_rows); lc_buf_free(&w->b_fsal_keys);
     free(w);
 }
 

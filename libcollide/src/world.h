@@ -125,14 +125,6 @@ struct lc_world {
     lc_buf b_cross, b_impact, b_irows, b_coupled, b_dacc, b_diag, b_warm, b_hash;
     int warm_count;          /* resting touches kept in b_warm from the previous pass (warm start) */
     double step_dt;          /* dt of the step in progress (stabilisation time scale) */
-    /* integrator.c only: the end of the last quiet interval, whose acceleration starts the next one
-     * (see quiet_start): the state it ended in, the rows advanced, their accelerations there and their
-     * applied (non-contact) accelerations there, the touches' keys, and what else the forces depend on */
-    lc_buf b_fsal_state, b_fsal_acc, b_fsal_applied, b_fsal_rows, b_fsal_keys;
-    int fsal_valid, fsal_rows, fsal_touches, fsal_count;
-    unsigned long fsal_edits;
-    double fsal_dt;
-    lc_world_def fsal_def;
 };
 
 /* ---- scratch memory ---- */
@@ -242,12 +234,6 @@ int lc_contact_forces(lc_world *w, const double *state, lc_touch *touches, int n
  * contacts. Rows not listed are copied unchanged only if copy_all. Returns 0 or -1. */
 int lc_integrate(lc_world *w, const double *s0, double h, const int *rows, int nrows,
                  lc_touch *touches, int ntouches, double *s1);
-/* lc_integrate for the intervals of a step that follow one another (its trials): a quiet interval that
- * starts exactly where the last quiet one ended takes that end's acceleration as its start (one contact
- * solve instead of two). Its result depends on that history; lc_integrate's never does, which the
- * time-of-impact searches need (their gap is a function of time). */
-int lc_integrate_chained(lc_world *w, const double *s0, double h, const int *rows, int nrows,
-                         lc_touch *touches, int ntouches, double *s1);
 
 /* ---- impulse.c ---- */
 /* Resolves the impact among touches[0..n) at the current state (velocities changed in place), with
