@@ -1,6 +1,7 @@
 /* hopping_block.c - an upright 1 m x 0.5 m block (1 kg, e 0.8, mu 0.5) rocking from corner to corner
  * on a static floor while it drifts sideways: the state one block of the hard-case settling scene
- * (tests/c/test_hard_settle.c, sc_rng seed 1) had at 10 s in a run of that scene, to 17 digits.
+ * (tests/c/test_hard_settle.c, sc_rng seed 1) had at 10 s, to 17 digits, in a run of that scene on an
+ * engine variant since withdrawn (docs/physics.md "Time stepping").
  * Before friction was kept against a slipping point's slip it hopped on forever, gaining ~1.5e-4 J
  * per rock (docs/physics.md "Resting contact"); it should come to rest within a few steps.
  *
