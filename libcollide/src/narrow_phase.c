@@ -42,9 +42,9 @@ double lc_vertex_edge_gap(const lc_world *w, const double *state, int a, int ver
     return edge_distance(&w->shape[b], edge, to_local(fb, p));
 }
 
-void lc_touch_update(const lc_world *w, const double *state, lc_touch *t)
+/* lc_touch_update with the frames of t->a and t->b at state already at hand. */
+static void touch_update(const lc_world *w, const double *state, frame fa, frame fb, lc_touch *t)
 {
-    frame fa = frame_of(w, state, t->a), fb = frame_of(w, state, t->b);
     const double *sa = &state[t->a * 6], *sb = &state[t->b * 6];
     lc_vec2 va, vb;
     t->ra = lc_rot(fa.c, fa.s, w->shape[t->a].v[t->vertex]);
@@ -55,6 +55,11 @@ void lc_touch_update(const lc_world *w, const double *state, lc_touch *t)
     va = lc_add(lc_v(sa[SVX], sa[SVY]), lc_wcross(sa[SW], t->ra));
     vb = lc_add(lc_v(sb[SVX], sb[SVY]), lc_wcross(sb[SW], t->rb));
     t->vn = lc_dot(t->n, lc_sub(va, vb));
+}
+
+void lc_touch_update(const lc_world *w, const double *state, lc_touch *t)
+{
+    touch_update(w, state, frame_of(w, state, t->a), frame_of(w, state, t->b), t);
 }
 
 static double mix(lc_mix_rule r, double x, double y)
@@ -68,11 +73,12 @@ static double mix(lc_mix_rule r, double x, double y)
     return x < y ? x : y;
 }
 
-static int push_touch(const lc_world *w, const double *state, lc_buf *buf, int count, int first_of_pair,
-                      int a, int vertex, int b, int edge, double max_gap)
+/* fa, fb: the frames of a and b at state. */
+static int push_touch(const lc_world *w, const double *state, frame fa, frame fb, lc_buf *buf, int count,
+                      int first_of_pair, int a, int vertex, int b, int edge, double max_gap)
 {
     lc_touch *t = (lc_touch *)buf->p;
-    lc_vec2 p = to_world(frame_of(w, state, a), w->shape[a].v[vertex]);
+    lc_vec2 p = to_world(fa, w->shape[a].v[vertex]);
     /* A point already recorded for this pair at (nearly) the same place is the same contact. "Nearly"
      * is max_gap, but never a quarter of the smaller body: with a contact_distance of 0.5 m (the API
      * allows up to 1 m) two corners of a 5 cm box were one contact, and the corner that sank into a
@@ -96,24 +102,27 @@ static int push_touch(const lc_world *w, const double *state, lc_buf *buf, int c
     t->vn_pre = 0.0;
     t->target_vn = 0.0;
     t->tangent = 0.0;
-    lc_touch_update(w, state, t);
+    touch_update(w, state, fa, fb, t);
     return count + 1;
 }
 
-/* Largest separation of body `a`'s vertices along the outward normals of `b`'s edges (the separating
- * axis test): returns it and the edge in *edge. */
-static double max_separation(const lc_world *w, const double *state, int a, int b, int *edge)
+/* Body a's vertices in the frame of body b (fa, fb: their frames), into local[]. */
+static void vertices_in(const lc_shape *sa, frame fa, frame fb, lc_vec2 *local)
 {
-    const lc_shape *sa = &w->shape[a], *sb = &w->shape[b];
-    frame fa = frame_of(w, state, a), fb = frame_of(w, state, b);
-    lc_vec2 local[LC_MAX_POLYGON_VERTICES];
+    int i;
+    for (i = 0; i < sa->count; ++i) local[i] = to_local(fb, to_world(fa, sa->v[i]));
+}
+
+/* Largest separation of a body's vertices (local[0..count), in the frame of the body of shape sb)
+ * along the outward normals of sb's edges (the separating axis test): returns it and the edge in *edge. */
+static double max_separation(const lc_shape *sb, const lc_vec2 *local, int count, int *edge)
+{
     double best = -INFINITY;
     int i, k;
-    for (i = 0; i < sa->count; ++i) local[i] = to_local(fb, to_world(fa, sa->v[i]));
     *edge = 0;
     for (k = 0; k < sb->count; ++k) {
         double sep = INFINITY;
-        for (i = 0; i < sa->count; ++i) {
+        for (i = 0; i < count; ++i) {
             double d = edge_distance(sb, k, local[i]);
             if (d < sep) sep = d;
         }
@@ -122,28 +131,33 @@ static double max_separation(const lc_world *w, const double *state, int a, int 
     return best;
 }
 
-/* Vertices of body `inc` within max_gap of edge `edge` of body `ref` (and over its extent). */
-static int face_touches(const lc_world *w, const double *state, int inc, int ref, int edge, double max_gap,
-                        lc_buf *buf, int count, int first_of_pair)
+/* Vertices of body `inc` (local[]: in the frame of `ref`; fi, fr: the two frames) within max_gap of edge
+ * `edge` of body `ref` (and over its extent). */
+static int face_touches(const lc_world *w, const double *state, int inc, int ref, frame fi, frame fr,
+                        const lc_vec2 *local, int edge, double max_gap, lc_buf *buf, int count, int first_of_pair)
 {
     const lc_shape *si = &w->shape[inc], *sr = &w->shape[ref];
-    frame fi = frame_of(w, state, inc), fr = frame_of(w, state, ref);
     int i;
     for (i = 0; i < si->count && count >= 0; ++i) {
-        lc_vec2 local = to_local(fr, to_world(fi, si->v[i]));
-        double d = edge_distance(sr, edge, local), len, u;
+        double d = edge_distance(sr, edge, local[i]), len, u;
         if (!(d < max_gap)) continue;
-        u = edge_param(sr, edge, local, &len);
+        u = edge_param(sr, edge, local[i], &len);
         if (u * len < -max_gap || (u - 1.0) * len > max_gap) continue;
-        count = push_touch(w, state, buf, count, first_of_pair, inc, i, ref, edge, max_gap);
+        count = push_touch(w, state, fi, fr, buf, count, first_of_pair, inc, i, ref, edge, max_gap);
     }
     return count;
 }
 
 double lc_pair_separation(const lc_world *w, const double *state, int a, int b)
 {
+    frame fa = frame_of(w, state, a), fb = frame_of(w, state, b);
+    lc_vec2 a_in_b[LC_MAX_POLYGON_VERTICES], b_in_a[LC_MAX_POLYGON_VERTICES];
     int ka, kb;
-    double sb = max_separation(w, state, a, b, &kb), sa = max_separation(w, state, b, a, &ka);
+    double sb, sa;
+    vertices_in(&w->shape[a], fa, fb, a_in_b);
+    vertices_in(&w->shape[b], fb, fa, b_in_a);
+    sb = max_separation(&w->shape[b], a_in_b, w->shape[a].count, &kb);
+    sa = max_separation(&w->shape[a], b_in_a, w->shape[b].count, &ka);
     return sa > sb ? sa : sb;
 }
 
@@ -152,7 +166,8 @@ int lc_collect_touches(const lc_world *w, const double *state, int a, int b, dou
 {
     int first = count, ka, kb, ref, inc, kref, kinc, k;
     double sep_a, sep_b, best = INFINITY;
-    lc_vec2 n;
+    lc_vec2 n, a_in_b[LC_MAX_POLYGON_VERTICES], b_in_a[LC_MAX_POLYGON_VERTICES];
+    frame fa, fb, fref, finc;
     if (w->is_static[a] && w->is_static[b]) return count;
     {
         /* bounding circles farther apart than max_gap: no touch, without the separating-axis test */
@@ -165,8 +180,12 @@ int lc_collect_touches(const lc_world *w, const double *state, int a, int b, dou
     /* The contact normal of a pair comes from its separating axis: the face of either body along
      * which they are farthest apart (least overlap). At coincident corners of side-by-side boxes this
      * picks the shared vertical faces, never the collinear top or bottom faces. */
-    sep_b = max_separation(w, state, a, b, &kb);   /* a's vertices against b's faces */
-    sep_a = max_separation(w, state, b, a, &ka);   /* b's vertices against a's faces */
+    fa = frame_of(w, state, a);
+    fb = frame_of(w, state, b);
+    vertices_in(&w->shape[a], fa, fb, a_in_b);
+    vertices_in(&w->shape[b], fb, fa, b_in_a);
+    sep_b = max_separation(&w->shape[b], a_in_b, w->shape[a].count, &kb);   /* a's vertices against b's faces */
+    sep_a = max_separation(&w->shape[a], b_in_a, w->shape[b].count, &ka);   /* b's vertices against a's faces */
     if (!(sep_a < max_gap) && !(sep_b < max_gap)) return count;
     /* ties (within a hundredth of the gap) go to b's face so the choice does not flicker */
     if (sep_a > sep_b + 0.01 * w->def.contact_gap) { ref = a; kref = ka; inc = b; }
@@ -175,25 +194,21 @@ int lc_collect_touches(const lc_world *w, const double *state, int a, int b, dou
         /* separated along one body's face by more than max_gap: not touching */
         if ((ref == a ? sep_a : sep_b) >= max_gap) return count;
     }
+    fref = ref == a ? fa : fb;
+    finc = ref == a ? fb : fa;
     /* incident face: the face of the other body most opposed to the reference normal */
-    {
-        double c, sn;
-        lc_body_trig(w, ref, state[ref * 6 + SA], &c, &sn);
-        n = lc_rot(c, sn, w->shape[ref].n[kref]);
-    }
+    n = lc_rot(fref.c, fref.s, w->shape[ref].n[kref]);
     kinc = 0;
-    {
-        double c, sn;
-        lc_body_trig(w, inc, state[inc * 6 + SA], &c, &sn);
-        for (k = 0; k < w->shape[inc].count; ++k) {
-            double d = lc_dot(n, lc_rot(c, sn, w->shape[inc].n[k]));
-            if (d < best) { best = d; kinc = k; }
-        }
+    for (k = 0; k < w->shape[inc].count; ++k) {
+        double d = lc_dot(n, lc_rot(finc.c, finc.s, w->shape[inc].n[k]));
+        if (d < best) { best = d; kinc = k; }
     }
-    count = face_touches(w, state, inc, ref, kref, max_gap, buf, count, first);
+    count = face_touches(w, state, inc, ref, finc, fref, inc == a ? a_in_b : b_in_a, kref, max_gap, buf, count,
+                         first);
     if (count < 0) return count;
     /* the reference body's corners under the incident face (offset boxes: one point each way) */
-    return face_touches(w, state, ref, inc, kinc, max_gap, buf, count, first);
+    return face_touches(w, state, ref, inc, fref, finc, ref == a ? a_in_b : b_in_a, kinc, max_gap, buf, count,
+                        first);
 }
 
 static int crossings_one_way(const lc_world *w, int a, int b, frame fa0, frame fb0, frame fa1, frame fb1,

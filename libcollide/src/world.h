@@ -101,6 +101,10 @@ struct lc_world {
     lc_buf b_step_scratch;   /* step.c only: held across the whole step, so no other file may use it */
     lc_buf b_sample0, b_sample1; /* step.c only: sub-interval states of the swept check */
     lc_buf b_marked_rows;    /* broad_phase.c: the marked rows of lc_broad_phase_of in row order */
+    /* broad_phase.c: the rows in the last sort-and-sweep's x order (sweep_rows of them), the boxes
+     * being sorted, and the counting sort of the pairs */
+    lc_buf b_sweep_order, b_sweep_boxes, b_pair_start, b_pair_tmp;
+    int sweep_rows;
     lc_buf b_swept;          /* step.c only: the whole world at the swept check's sub-times */
     lc_buf b_rkeys;
     lc_buf b_emark;          /* step.c only: bodies under resting contact, for the energy check */
