@@ -43,6 +43,16 @@ static lc_world *build(int which)
         w = sc_world(&d);
         hc_settling_layout(w, 1, 0.8, 0.5, ids);
         return w;
+    case 5: /* the scaling scene's 400 blocks (sort-and-sweep), e = 1, g = 0 */
+        d.gravity.y = 0.0;
+        d.damping = 0.0;
+        w = sc_world(&d);
+        hc_walls(w, 0.0, 0.0, 46.0, 46.0, 1.0, 0.0, ids);
+        rng.s = 11;
+        for (i = 0; i < 400; i++)
+            hc_box(w, 1.0, 0.5, 1.0 + 2.0 * (i % 23), 1.0 + 2.0 * (i / 23), sc_uniform(&rng, 0.0, SC_PI),
+                   sc_uniform(&rng, -3, 3), sc_uniform(&rng, -3, 3), sc_uniform(&rng, -2, 2), 1.0, 1.0, 0.0);
+        return w;
     default: /* a stack of 10 */
         d.gravity.y = -9.8;
         w = sc_world(&d);
@@ -55,7 +65,7 @@ static lc_world *build(int which)
 int main(void)
 {
     static const scene scenes[] = {{"pyramid20", 300}, {"pyramid50", 60}, {"seed_g0", 600},
-                                   {"seed_g9.8", 600}, {"settling", 1200}, {"stack10", 600}};
+                                   {"seed_g9.8", 600}, {"settling", 1200}, {"many400", 200}, {"stack10", 600}};
     int k;
     for (k = 0; k < (int)(sizeof scenes / sizeof scenes[0]); k++) {
         lc_world *w = build(k);

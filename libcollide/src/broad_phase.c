@@ -121,31 +121,30 @@ static box *sweep_sorted(lc_world *w, const box *by_row, int n)
     return b;
 }
 
-/* The pairs (a < b in each) in (a, b) order, as brute force finds them: a counting sort by a, then
- * each a's few b's by insertion. Returns 0, or -1 without memory. */
-static int order_pairs(lc_world *w, int *p, int count)
+/* One stable counting-sort pass of the pairs in `from` by their entry `key` (0: a, 1: b) into `to`. */
+static void pairs_by(const int *from, int *to, int count, int key, int *start, int n)
 {
-    int n = w->count, i, k;
-    int *start = lc_buf_get(&w->b_pair_start, (size_t)(n + 1) * sizeof(int));
-    int *q = lc_buf_get(&w->b_pair_tmp, (size_t)count * 2 * sizeof(int));
-    if (start == NULL || q == NULL) return -1;
+    int i, k;
     memset(start, 0, (size_t)(n + 1) * sizeof(int));
-    for (k = 0; k < count; ++k) start[p[2 * k] + 1]++;
+    for (k = 0; k < count; ++k) start[from[2 * k + key] + 1]++;
     for (i = 0; i < n; ++i) start[i + 1] += start[i];
     for (k = 0; k < count; ++k) {
-        int at = start[p[2 * k]]++;
-        q[2 * at] = p[2 * k];
-        q[2 * at + 1] = p[2 * k + 1];
+        int at = start[from[2 * k + key]]++;
+        to[2 * at] = from[2 * k];
+        to[2 * at + 1] = from[2 * k + 1];
     }
-    for (k = 1; k < count; ++k) {
-        int a = q[2 * k], b = q[2 * k + 1], j = k;
-        while (j > 0 && q[2 * j - 2] == a && q[2 * j - 1] > b) {
-            q[2 * j + 1] = q[2 * j - 1];
-            --j;
-        }
-        q[2 * j + 1] = b;
-    }
-    memcpy(p, q, (size_t)count * 2 * sizeof(int));
+}
+
+/* The pairs in (a, b) order, as brute force finds them: a radix sort, by b and then stably by a, in
+ * O(pairs + bodies) (a floor under thousands of boxes is one a with thousands of b's). Returns 0, or
+ * -1 without memory. */
+static int order_pairs(lc_world *w, int *p, int count)
+{
+    int *start = lc_buf_get(&w->b_pair_start, (size_t)(w->count + 1) * sizeof(int));
+    int *q = lc_buf_get(&w->b_pair_tmp, (size_t)count * 2 * sizeof(int));
+    if (start == NULL || q == NULL) return -1;
+    pairs_by(p, q, count, 1, start, w->count);
+    pairs_by(q, p, count, 0, start, w->count);
     return 0;
 }
 
