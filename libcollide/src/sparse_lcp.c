@@ -33,6 +33,77 @@ static lc_vec2 row_dir(const lc_touch *t, int tangent)
     return tangent ? lc_tangent_of(t->n) : t->n;
 }
 
+/* A row of A as a solve's products need it: its direction, its bodies' offsets in the 3-per-body
+ * response array (a3, b3; -1 for a static body), lever arms and inverse mass and inertia. A solve
+ * takes up to thousands of products of the same rows; reading these from one compact array instead of
+ * the touches, is_static, inv_mass and inv_inertia halves the loads of a product (the fuzz harness's
+ * time is 60 % in this solver, under AddressSanitizer, which checks every load). */
+typedef struct sparse_row {
+    lc_vec2 d, ra, rb;
+    double ima, iia, imb, iib;
+    int a3, b3;
+} sparse_row;
+
+static void prepare_rows(const lc_world *w, const lc_touch *t, int m, int tangent, sparse_row *r)
+{
+    int i;
+    for (i = 0; i < m; ++i) {
+        r[i].d = row_dir(&t[i], tangent);
+        r[i].ra = t[i].ra;
+        r[i].rb = t[i].rb;
+        r[i].a3 = w->is_static[t[i].a] ? -1 : t[i].a * 3;
+        r[i].b3 = w->is_static[t[i].b] ? -1 : t[i].b * 3;
+        r[i].ima = w->inv_mass[t[i].a];
+        r[i].iia = w->inv_inertia[t[i].a];
+        r[i].imb = w->inv_mass[t[i].b];
+        r[i].iib = w->inv_inertia[t[i].b];
+    }
+}
+
+/* out = A x over the prepared rows: lc_response_rows (response.c) with the same arithmetic in the same
+ * order, so bit for bit its answer. body: 3 doubles per body of the world, scratch. */
+static void product(const lc_world *w, const sparse_row *r, int m, const double *x, double *body, double *out)
+{
+    int i;
+    if (2 * m < w->count) {
+        for (i = 0; i < m; ++i) {
+            if (r[i].a3 >= 0) memset(&body[r[i].a3], 0, 3 * sizeof(double));
+            if (r[i].b3 >= 0) memset(&body[r[i].b3], 0, 3 * sizeof(double));
+        }
+    } else {
+        memset(body, 0, (size_t)w->count * 3 * sizeof(double));
+    }
+    for (i = 0; i < m; ++i) {
+        lc_vec2 push;
+        if (x[i] == 0.0) continue;
+        push = lc_scale(r[i].d, x[i]);
+        if (r[i].a3 >= 0) {
+            double *d = &body[r[i].a3];
+            d[0] += push.x * r[i].ima;
+            d[1] += push.y * r[i].ima;
+            d[2] += lc_cross(r[i].ra, push) * r[i].iia;
+        }
+        if (r[i].b3 >= 0) {
+            double *d = &body[r[i].b3];
+            d[0] -= push.x * r[i].imb;
+            d[1] -= push.y * r[i].imb;
+            d[2] -= lc_cross(r[i].rb, push) * r[i].iib;
+        }
+    }
+    for (i = 0; i < m; ++i) {
+        double v = 0.0;
+        if (r[i].a3 >= 0) {
+            const double *a = &body[r[i].a3];
+            v += lc_dot(r[i].d, lc_add(lc_v(a[0], a[1]), lc_wcross(a[2], r[i].ra)));
+        }
+        if (r[i].b3 >= 0) {
+            const double *b = &body[r[i].b3];
+            v -= lc_dot(r[i].d, lc_add(lc_v(b[0], b[1]), lc_wcross(b[2], r[i].rb)));
+        }
+        out[i] = v;
+    }
+}
+
 static double dot(const double *x, const double *y, int m)
 {
     double s = 0.0;
@@ -43,8 +114,8 @@ static double dot(const double *x, const double *y, int m)
 
 /* Largest eigenvalue of A, from below (power iteration). The start has unequal entries: the
  * all-ones vector can lie in A's null space (two opposite rows on one pair of bodies). */
-static double norm_estimate(const lc_world *w, const lc_touch *t, int m, int tangent, int iterations, double *v,
-                            double *av, double *body)
+static double norm_estimate(const lc_world *w, const sparse_row *r, int m, int iterations, double *v, double *av,
+                            double *body)
 {
     double lambda = 0.0, nv;
     int i, k;
@@ -53,7 +124,7 @@ static double norm_estimate(const lc_world *w, const lc_touch *t, int m, int tan
         nv = sqrt(dot(v, v, m));
         if (!(nv > 0.0)) break;
         for (i = 0; i < m; ++i) v[i] /= nv;
-        lc_response_rows(w, t, m, tangent, v, tangent, body, av);
+        product(w, r, m, v, body, av);
         lambda = dot(v, av, m);
         memcpy(v, av, (size_t)m * sizeof(double));
     }
@@ -68,29 +139,33 @@ static int is_free(double x, double lo, double hi)
 /* Free gradient phi, chopped gradient beta, and their squared norms; returns the largest entry of the
  * projected gradient phi + beta (the LCP's violation). With alpha > 0 also phi~.phi, where phi~ is
  * the free gradient cut to the step that would reach the bound (the proportioning test's measure). */
+/* One row of gradients(): phi and beta of the row, and its part of the sums and of the violation. */
+static void gradient_row(double xi, double gi, double lo, double hi, double alpha, double *phi, double *beta,
+                         double *sb, double *sp, double *worst)
+{
+    *phi = *beta = 0.0;
+    if (!(lo < hi)) {
+        return;   /* a fixed row (friction of a touch without normal force): never moves */
+    } else if (is_free(xi, lo, hi)) {
+        double room = gi > 0.0 ? (xi - lo) / alpha : (xi - hi) / alpha;
+        double cut = gi > 0.0 ? (room < gi ? room : gi) : (room > gi ? room : gi);
+        *phi = gi;
+        *sp += cut * gi;
+    } else if (xi <= lo) {
+        *beta = gi < 0.0 ? gi : 0.0;
+    } else {
+        *beta = gi > 0.0 ? gi : 0.0;
+    }
+    *sb += *beta * *beta;
+    if (fabs(*phi + *beta) > *worst) *worst = fabs(*phi + *beta);
+}
+
 static double gradients(const double *x, const double *g, const double *lo, const double *hi, int m, double alpha,
                         double *phi, double *beta, double *bb, double *pp)
 {
     double worst = 0.0, sb = 0.0, sp = 0.0;
     int i;
-    for (i = 0; i < m; ++i) {
-        double gi = g[i];
-        phi[i] = beta[i] = 0.0;
-        if (!(lo[i] < hi[i])) {
-            continue;   /* a fixed row (friction of a touch without normal force): never moves */
-        } else if (is_free(x[i], lo[i], hi[i])) {
-            double room = gi > 0.0 ? (x[i] - lo[i]) / alpha : (x[i] - hi[i]) / alpha;
-            double cut = gi > 0.0 ? (room < gi ? room : gi) : (room > gi ? room : gi);
-            phi[i] = gi;
-            sp += cut * gi;
-        } else if (x[i] <= lo[i]) {
-            beta[i] = gi < 0.0 ? gi : 0.0;
-        } else {
-            beta[i] = gi > 0.0 ? gi : 0.0;
-        }
-        sb += beta[i] * beta[i];
-        if (fabs(phi[i] + beta[i]) > worst) worst = fabs(phi[i] + beta[i]);
-    }
+    for (i = 0; i < m; ++i) gradient_row(x[i], g[i], lo[i], hi[i], alpha, &phi[i], &beta[i], &sb, &sp, &worst);
     *bb = sb;
     *pp = sp;
     return worst;
@@ -116,12 +191,16 @@ int lc_sparse_lcp(lc_world *w, const lc_touch *t, int m, int tangent, const doub
     double *body = lc_buf_get(&w->b_sparse_body, (size_t)w->count * 3 * sizeof(double));
     double *g = lc_buf_get(&w->b_sparse, (size_t)m * 6 * sizeof(double));
     double *p, *ap, *phi, *beta, *d, alpha, lambda, worst, bb, pp;
+    sparse_row *rows;
     int i, products = 0, restarted = 0, refreshed = 0;
     if (body == NULL || g == NULL) return -1;
     if (m == 0) {
         *violation = 0.0;
         return 0;
     }
+    rows = lc_buf_get(&w->b_sparse_rows, (size_t)m * sizeof(sparse_row));
+    if (rows == NULL) return -1;
+    prepare_rows(w, t, m, tangent, rows);
     p = g + m;
     ap = p + m;
     phi = ap + m;
@@ -130,7 +209,7 @@ int lc_sparse_lcp(lc_world *w, const lc_touch *t, int m, int tangent, const doub
     if (w->sparse_norm_rows[tangent != 0] == m) {
         lambda = w->sparse_norm[tangent != 0];
     } else {
-        lambda = norm_estimate(w, t, m, tangent, LC_MPRGP_POWER_ITERATIONS, p, ap, body);
+        lambda = norm_estimate(w, rows, m, LC_MPRGP_POWER_ITERATIONS, p, ap, body);
         products += LC_MPRGP_POWER_ITERATIONS;
         refreshed = 1;
         w->sparse_norm[tangent != 0] = lambda;
@@ -158,17 +237,29 @@ int lc_sparse_lcp(lc_world *w, const lc_touch *t, int m, int tangent, const doub
         if (!isfinite(x[i])) x[i] = 0.0;
         x[i] = fmin(fmax(x[i], lo[i]), hi[i]);
     }
-    lc_response_rows(w, t, m, tangent, x, tangent, body, g);
+    product(w, rows, m, x, body, g);
     products++;
     for (i = 0; i < m; ++i) g[i] += b[i];
     worst = gradients(x, g, lo, hi, m, alpha, phi, beta, &bb, &pp);
     memcpy(p, phi, (size_t)m * sizeof(double));
     while (worst > tol && products < max_products) {
         if (bb <= LC_MPRGP_GAMMA * LC_MPRGP_GAMMA * pp) {
-            double pap, acg, af;
-            lc_response_rows(w, t, m, tangent, p, tangent, body, ap);
+            double pap, gp, acg, af;
+            product(w, rows, m, p, body, ap);
             products++;
-            pap = dot(p, ap, m);
+            /* p.Ap, g.p and the feasible step in one pass (each sum in the order dot() takes) */
+            pap = 0.0;
+            gp = 0.0;
+            af = INFINITY;
+            for (i = 0; i < m; ++i) {
+                double si = INFINITY;
+                pap += p[i] * ap[i];
+                gp += g[i] * p[i];
+                if (p[i] > 0.0 && lo[i] > -INFINITY) si = (x[i] - lo[i]) / p[i];
+                else if (p[i] < 0.0 && hi[i] < INFINITY) si = (x[i] - hi[i]) / p[i];
+                if (si < af) af = si;
+            }
+            if (!(af > 0.0)) af = 0.0;
             if (!(pap > 0.0)) {
                 /* p in the null space of A (redundant contacts): restart once from the free gradient */
                 if (restarted) break;
@@ -177,17 +268,21 @@ int lc_sparse_lcp(lc_world *w, const lc_touch *t, int m, int tangent, const doub
                 continue;
             }
             restarted = 0;
-            acg = dot(g, p, m) / pap;
-            af = feasible_step(x, p, lo, hi, m);
+            acg = gp / pap;
             if (acg <= af) {
-                double gamma;
+                double phap = 0.0, sb = 0.0, sp = 0.0, gamma;
+                worst = 0.0;
+                /* the step, the new gradients and phi.Ap in one pass (the order gradients() and dot() take) */
                 for (i = 0; i < m; ++i) {
                     /* within the feasible step: the clamp only takes off round-off past a bound */
                     x[i] = clamp(x[i] - acg * p[i], lo[i], hi[i]);
                     g[i] -= acg * ap[i];
+                    gradient_row(x[i], g[i], lo[i], hi[i], alpha, &phi[i], &beta[i], &sb, &sp, &worst);
+                    phap += phi[i] * ap[i];
                 }
-                worst = gradients(x, g, lo, hi, m, alpha, phi, beta, &bb, &pp);
-                gamma = dot(phi, ap, m) / pap;
+                bb = sb;
+                pp = sp;
+                gamma = phap / pap;
                 for (i = 0; i < m; ++i) p[i] = phi[i] - gamma * p[i];
             } else {
                 /* expansion: up to the bound, then a projected gradient step with the fixed length */
@@ -196,7 +291,7 @@ int lc_sparse_lcp(lc_world *w, const lc_touch *t, int m, int tangent, const doub
                     g[i] -= af * ap[i];
                 }
                 if (!refreshed) {   /* p and ap are free until p is reset below */
-                    double fresh = norm_estimate(w, t, m, tangent, LC_MPRGP_POWER_REFRESH, p, ap, body);
+                    double fresh = norm_estimate(w, rows, m, LC_MPRGP_POWER_REFRESH, p, ap, body);
                     products += LC_MPRGP_POWER_REFRESH;
                     refreshed = 1;
                     if (fresh > lambda && isfinite(fresh)) {
@@ -207,7 +302,7 @@ int lc_sparse_lcp(lc_world *w, const lc_touch *t, int m, int tangent, const doub
                 }
                 worst = gradients(x, g, lo, hi, m, alpha, phi, beta, &bb, &pp);
                 for (i = 0; i < m; ++i) x[i] = clamp(x[i] - alpha * phi[i], lo[i], hi[i]);
-                lc_response_rows(w, t, m, tangent, x, tangent, body, g);
+                product(w, rows, m, x, body, g);
                 products++;
                 for (i = 0; i < m; ++i) g[i] += b[i];
                 worst = gradients(x, g, lo, hi, m, alpha, phi, beta, &bb, &pp);
@@ -217,7 +312,7 @@ int lc_sparse_lcp(lc_world *w, const lc_touch *t, int m, int tangent, const doub
             /* proportioning: move the rows that their bound holds against their gradient */
             double dad, step, cap;
             memcpy(d, beta, (size_t)m * sizeof(double));
-            lc_response_rows(w, t, m, tangent, d, tangent, body, ap);
+            product(w, rows, m, d, body, ap);
             products++;
             dad = dot(d, ap, m);
             if (!(dad > 0.0)) break;

@@ -109,7 +109,7 @@ struct lc_world {
     lc_buf b_rkeys;
     lc_buf b_emark;          /* step.c only: bodies under resting contact, for the energy check */
     lc_buf b_isl, b_isl_touch, b_isl_pick, b_isl_pick_touch; /* step.c only: islands of a pass */
-    lc_buf b_sparse, b_sparse_body; /* sparse_lcp.c: its vectors and the bodies' responses */
+    lc_buf b_sparse, b_sparse_body, b_sparse_rows; /* sparse_lcp.c: its vectors, the bodies' responses, its rows */
     double sparse_norm[2];   /* sparse_lcp.c: last ||A|| estimate of normal [0] and tangent [1] rows, */
     int sparse_norm_rows[2]; /* and its row count: a pile's A changes little from one solve to the next */
     lc_buf b_group_rows;     /* contact_forces.c: right-hand sides, bounds and forces of a large group */
