@@ -105,8 +105,9 @@ static int advance_quiet(lc_world *w, const double *s0, double h, const int *iro
     return 1;
 }
 
-int lc_integrate(lc_world *w, const double *s0, double h, const int *rows, int nrows,
-                 lc_touch *touches, int nt, double *s1)
+/* copy_all: every row of s1 is written (the unlisted ones as in s0); otherwise only the listed rows. */
+static int integrate(lc_world *w, const double *s0, double h, const int *rows, int nrows, lc_touch *touches, int nt,
+                     double *s1, int copy_all)
 {
     size_t bytes = (size_t)w->count * 6 * sizeof(double);
     int *flags, *irows, ni = 0, i;
@@ -116,7 +117,11 @@ int lc_integrate(lc_world *w, const double *s0, double h, const int *rows, int n
     irows = lc_buf_get(&w->b_irows, (size_t)(nrows > 0 ? nrows : 1) * sizeof(int));
     acc = lc_buf_get(&w->b_acc, (size_t)w->count * 3 * sizeof(double));
     if (!flags || !irows || !acc) return -1;
-    if (s1 != s0) memcpy(s1, s0, bytes);
+    if (s1 != s0 && copy_all) memcpy(s1, s0, bytes);
+    /* a moving row is written whole below when time passes; a static one only here */
+    if (s1 != s0 && !copy_all)
+        for (i = 0; i < nrows; ++i)
+            if (h == 0.0 || w->is_static[rows[i]]) memcpy(&s1[rows[i] * 6], &s0[rows[i] * 6], 6 * sizeof(double));
     if (h == 0.0) return 0;   /* no time passes: no force evaluation (a pile's is a full contact solve) */
     memset(flags, 0, (size_t)w->count * sizeof(int));
     for (i = 0; i < nt; ++i) flags[touches[i].a] = flags[touches[i].b] = 1;
@@ -171,4 +176,16 @@ int lc_integrate(lc_world *w, const double *s0, double h, const int *rows, int n
     /* the last evaluation's contact forces describe the end of the interval closely enough for output;
      * re-evaluate at s1 so reported forces belong to the reported state */
     return 0;
+}
+
+int lc_integrate(lc_world *w, const double *s0, double h, const int *rows, int nrows,
+                 lc_touch *touches, int nt, double *s1)
+{
+    return integrate(w, s0, h, rows, nrows, touches, nt, s1, 1);
+}
+
+int lc_integrate_rows(lc_world *w, const double *s0, double h, const int *rows, int nrows,
+                      lc_touch *touches, int nt, double *s1)
+{
+    return integrate(w, s0, h, rows, nrows, touches, nt, s1, 0);
 }

@@ -919,7 +919,7 @@ lc_status lc_world_step(lc_world *w, double dt)
         local = can_reuse && nrest == 0 && events == events_before && !body_springs;
         ts = lc_stage_begin(w);
         if (local) {
-            if (lc_integrate(w, s0, trial, drows, ndirty, rest, 0, scratch) != 0) goto oom;
+            if (lc_integrate_rows(w, s0, trial, drows, ndirty, rest, 0, scratch) != 0) goto oom;
             for (i = 0; i < ndirty; ++i) memcpy(&s1[drows[i] * 6], &scratch[drows[i] * 6], 6 * sizeof(double));
         } else {
             if (lc_integrate(w, s0, trial, rows, nrows, rest, nrest, s1) != 0) goto oom;
@@ -1027,7 +1027,7 @@ lc_status lc_world_step(lc_world *w, double dt)
         ts = lc_stage_begin(w);
         if (tmin > 0.0) {
             int ba = cross[best].a, bb = cross[best].b;
-            if (lc_integrate(w, s0, tmin, rows, nrows, rest, nrest, w->state) != 0) goto oom;
+            if (lc_integrate_rows(w, s0, tmin, rows, nrows, rest, nrest, w->state) != 0) goto oom;
             /* another vertex of the pair (corner against corner) already inside, deeper than any
              * crossing test can see from here on: the pair met earlier, find when */
             if (lc_pair_separation(w, w->state, ba, bb) < -0.5 * w->def.contact_gap &&
@@ -1045,7 +1045,7 @@ lc_status lc_world_step(lc_world *w, double dt)
                 if (t2 < 0.0) goto oom;
                 tmin = t2;
                 by_pair = 1;
-                if (lc_integrate(w, s0, tmin, rows, nrows, rest, nrest, w->state) != 0) goto oom;
+                if (lc_integrate_rows(w, s0, tmin, rows, nrows, rest, nrest, w->state) != 0) goto oom;
             }
         } else {
             memcpy(w->state, s0, (size_t)w->count * 6 * sizeof(double));

@@ -2,6 +2,7 @@
  * edge. The gap function is evaluated by re-integrating the involved bodies from the step's start,
  * so the impact state is the one the integrator would have produced, not an interpolation. */
 #include <math.h>
+#include <string.h>
 #include "world.h"
 
 /* Gap of the crossing's vertex at time tau after s0, minus the target gap. */
@@ -9,7 +10,8 @@ static double gap_at(lc_world *w, const double *s0, double tau, const lc_crossin
                      int nrows, lc_touch *touches, int nt, double *scratch, double target)
 {
     if (tau > 0.0) {
-        if (lc_integrate(w, s0, tau, rows, nrows, touches, nt, scratch) != 0) return NAN;
+        /* only the listed rows are integrated into scratch: a static body's row is copied once below */
+        if (lc_integrate_rows(w, s0, tau, rows, nrows, touches, nt, scratch) != 0) return NAN;
         w->last.toi_iterations++;
         return lc_vertex_edge_gap(w, scratch, c->a, c->vertex, c->b, c->edge) - target;
     }
@@ -36,6 +38,9 @@ double lc_time_of_impact(lc_world *w, const double *s0, double h, const lc_cross
     int it, side = 0;
     double va;
     w->last.toi_searches++;
+    /* the crossing's rows as at s0 (a static body is not integrated), the others not read */
+    memcpy(&scratch[c->a * 6], &s0[c->a * 6], 6 * sizeof(double));
+    memcpy(&scratch[c->b * 6], &s0[c->b * 6], 6 * sizeof(double));
     fa = gap_at(w, s0, 0.0, c, rows, nrows, touches, nt, scratch, target);
     va = gap_rate(w, s0, c);
     if (!(fa > d->toi_distance_tolerance)) {
@@ -121,9 +126,12 @@ double lc_pair_time_of_impact(lc_world *w, const double *s0, double h, int a, in
     double lo = 0.0, hi = h;
     int it;
     w->last.toi_searches++;
+    /* the pair's rows as at s0 (a static body is not integrated), the others not read */
+    memcpy(&scratch[a * 6], &s0[a * 6], 6 * sizeof(double));
+    memcpy(&scratch[b * 6], &s0[b * 6], 6 * sizeof(double));
     for (it = 0; it < 200 && hi - lo > d->toi_time_tolerance; ++it) {
         double m = 0.5 * (lo + hi), g;
-        if (lc_integrate(w, s0, m, rows, nrows, touches, ntouches, scratch) != 0) return -1.0;
+        if (lc_integrate_rows(w, s0, m, rows, nrows, touches, ntouches, scratch) != 0) return -1.0;
         w->last.toi_iterations++;
         g = lc_pair_separation(w, scratch, a, b) - d->contact_gap;
         if (!isfinite(g)) return -1.0;

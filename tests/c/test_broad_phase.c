@@ -7,7 +7,9 @@
  * between calls - small random moves, a mirror in x (the worst start for an insertion sort), a full
  * shuffle of positions, an interval with a different end state (swept boxes), and boxes stacked in
  * one column (every box overlaps every other in x) - and after each the pair list of sort-and-sweep
- * must equal brute force's entry for entry, with no tolerance: both test the same boxes. */
+ * must equal brute force's entry for entry, with no tolerance: both test the same boxes. So must the
+ * pairs of lc_broad_phase_of (the pairs of a few listed bodies, after an impact) equal brute force's
+ * pairs that have a listed body. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -39,6 +41,39 @@ static void compare(lc_world *w, const double *s0, const double *s1, const char 
     CHECK(nb > 0, "%s: the scene has candidate pairs", what);
     CHECK(nb == ns, "%s: %d pairs by brute force, %d by sort-and-sweep", what, nb, ns);
     if (nb == ns) CHECK(memcmp(brute, sweep, (size_t)nb * 2 * sizeof(int)) == 0, "%s: the same pairs in the same order", what);
+}
+
+/* lc_broad_phase_of, which computes the boxes of unlisted bodies only when their centres' bound comes
+ * near a listed one, against brute force's pairs with a listed body: the same pairs in the same order. */
+static void compare_of(lc_world *w, const double *s0, const double *s1, const char *what, int *brute, int *sweep,
+                       sc_rng *rng)
+{
+    lc_buf buf = {0};
+    uint8_t *marked = calloc((size_t)w->count, 1);
+    int list[8], nlist = 0, nb, ns, k, kept = 0;
+    CHECK(marked != NULL, "%s", "allocation");
+    if (marked == NULL) return;
+    while (nlist < 8) {
+        int r = 1 + (int)(sc_rand(rng) * (w->count - 1));
+        if (!marked[r]) { marked[r] = 1; list[nlist++] = r; }
+    }
+    nb = pairs_of(w, LC_BROADPHASE_BRUTE_FORCE, s0, s1, brute);
+    for (k = 0; k < nb; ++k)
+        if (marked[brute[2 * k]] || marked[brute[2 * k + 1]]) {
+            brute[2 * kept] = brute[2 * k];
+            brute[2 * kept + 1] = brute[2 * k + 1];
+            kept++;
+        }
+    ns = lc_broad_phase_of(w, s0, s1, w->def.contact_distance, marked, list, nlist, &buf);
+    printf("%-34s %6d pairs with 8 listed bodies (brute force) %6d (lc_broad_phase_of)\n", what, kept, ns);
+    CHECK(kept > 0, "%s: the listed bodies have candidate pairs", what);
+    CHECK(ns == kept, "%s: %d pairs by brute force, %d by lc_broad_phase_of", what, kept, ns);
+    if (ns == kept && ns > 0) {
+        memcpy(sweep, buf.p, (size_t)ns * 2 * sizeof(int));
+        CHECK(memcmp(brute, sweep, (size_t)ns * 2 * sizeof(int)) == 0, "%s: the same pairs in the same order", what);
+    }
+    lc_buf_free(&buf);
+    free(marked);
 }
 
 int main(void)
@@ -80,9 +115,11 @@ int main(void)
         }
     }
     compare(w, s0, s0, "positions shuffled", brute, sweep);
+    compare_of(w, s0, s0, "positions shuffled", brute, sweep, &rng);
     memcpy(s1, s0, (size_t)rows * 6 * sizeof(double));
     for (i = 1; i < rows; i++) s1[i * 6 + SX] += sc_uniform(&rng, -2.0, 2.0);
     compare(w, s0, s1, "swept over an interval", brute, sweep);
+    compare_of(w, s0, s1, "swept over an interval", brute, sweep, &rng);
     for (i = 1; i < rows; i++) {
         s0[i * 6 + SX] = sc_uniform(&rng, -0.1, 0.1);
         s0[i * 6 + SY] = 0.8 * i;
