@@ -12,12 +12,27 @@
 
 typedef struct scene { const char *name; int steps; } scene;
 
+/* n seed blocks (1 m x 0.5 m, 1 kg, e = 1) on a grid of 2 m cells, cols a row, in walls around it,
+ * random angles, velocities in [-3, 3]^2 m/s and spins in [-2, 2] rad/s from generator seed. */
+static lc_world *blocks_in_box(const lc_world_def *d, int n, int cols, uint64_t seed)
+{
+    lc_world *w = sc_world(d);
+    lc_body_id walls[4];
+    sc_rng rng;
+    int i;
+    hc_walls(w, 0.0, 0.0, 2.0 * cols, 2.0 * cols, 1.0, 0.0, walls);
+    rng.s = seed;
+    for (i = 0; i < n; i++)
+        hc_box(w, 1.0, 0.5, 1.0 + 2.0 * (i % cols), 1.0 + 2.0 * (i / cols), sc_uniform(&rng, 0.0, SC_PI),
+               sc_uniform(&rng, -3, 3), sc_uniform(&rng, -3, 3), sc_uniform(&rng, -2, 2), 1.0, 1.0, 0.0);
+    return w;
+}
+
 static lc_world *build(int which)
 {
     lc_world_def d = lc_default_world_def();
     lc_world *w;
     lc_body_id ids[20];
-    sc_rng rng;
     int i;
     switch (which) {
     case 0: /* pyramid base 20 (Box2D's layout, mu 0.6, g = 10) */
@@ -31,13 +46,7 @@ static lc_world *build(int which)
     case 3: /* the same at g = 9.8 */
         d.gravity.y = which == 2 ? 0.0 : -9.8;
         d.damping = 0.0;
-        w = sc_world(&d);
-        hc_walls(w, 0.0, 0.0, 10.0, 10.0, 1.0, 0.0, ids);
-        rng.s = 7;
-        for (i = 0; i < 20; i++)
-            hc_box(w, 1.0, 0.5, 1.0 + 2.0 * (i % 5), 1.0 + 2.0 * (i / 5), sc_uniform(&rng, 0.0, SC_PI),
-                   sc_uniform(&rng, -3, 3), sc_uniform(&rng, -3, 3), sc_uniform(&rng, -2, 2), 1.0, 1.0, 0.0);
-        return w;
+        return blocks_in_box(&d, 20, 5, 7);
     case 4: /* the settling scene, layout 1 (e 0.8, mu 0.5) */
         d.gravity.y = -9.8;
         w = sc_world(&d);
@@ -46,13 +55,7 @@ static lc_world *build(int which)
     case 5: /* the scaling scene's 400 blocks (sort-and-sweep), e = 1, g = 0 */
         d.gravity.y = 0.0;
         d.damping = 0.0;
-        w = sc_world(&d);
-        hc_walls(w, 0.0, 0.0, 46.0, 46.0, 1.0, 0.0, ids);
-        rng.s = 11;
-        for (i = 0; i < 400; i++)
-            hc_box(w, 1.0, 0.5, 1.0 + 2.0 * (i % 23), 1.0 + 2.0 * (i / 23), sc_uniform(&rng, 0.0, SC_PI),
-                   sc_uniform(&rng, -3, 3), sc_uniform(&rng, -3, 3), sc_uniform(&rng, -2, 2), 1.0, 1.0, 0.0);
-        return w;
+        return blocks_in_box(&d, 400, 23, 11);
     default: /* a stack of 10 */
         d.gravity.y = -9.8;
         w = sc_world(&d);
