@@ -1,7 +1,7 @@
 """libcollide against Box2D v3 (pyb2d3), Chipmunk2D (pymunk) and Box2D 2.3 (pybox2d): speed against
 error on the issue-4 scenes. Use bench/run (it installs bench/requirements.txt first).
 
-    bench/run [--quick | --full] [--sections wp,impacts,cradle,stacks,pyramid,tunnel,scaling]
+    bench/run [--quick | --full] [--sections wp,ref,impacts,cradle,tunnel,stacks,hard,pyramid,scaling]
 
 Writes docs/benchmarks.md, docs/img/bench_*.png and bench/results/latest.json."""
 from __future__ import annotations
@@ -44,6 +44,15 @@ WP_VARIANTS: dict[str, list[tuple[str, dict, tuple[float, ...]]]] = {
     "box2d2": [("box2d2", {}, DTS), ("box2d2 20/10 it", {"velocity_iterations": 20, "position_iterations": 10},
                                      DTS[:1])],
 }
+# Trajectory reference (section "ref"): libcollide at its tightest TOI tolerances. Computed at dt 1/60
+# and at 1/960, seeds 1-3 (run of 2026-11-23 12:05, docs/benchmarks.md (1b)), it agrees with itself to
+# 2.6e-12 m over 0.5 s, but at 1 s one g = 9.8 seed is 1.7 m apart and by 2 s all are metres apart
+# (chaos), so REF_T = 0.5 s; the check runs to 2 s so that every run shows where the horizon stands.
+REF_T = 0.5
+REF_CHECK_T = 2.0
+REF_CHECK_AT = (0.25, 0.5, 1.0, 2.0)
+REF_SETTINGS = {"toi_time_tolerance": 1e-14, "toi_distance_tolerance": 1e-14}
+HALF_DIAGONAL = math.hypot(scenes.BLOCK_W, scenes.BLOCK_H) / 2
 
 
 def log(msg: str) -> None:
@@ -135,6 +144,62 @@ class Bench:
             six.append({**strip(r), **m, "g": g})
         out["n6"] = six
         self.out["wp"] = out
+
+    # ---- (1) seed scene: trajectory error against a converged reference ------------------------
+    def ref(self) -> None:
+        """Each engine's trajectory against libcollide at its tightest TOI tolerances, over REF_T s of
+        the seed scene. The scene is chaotic (every block-block impact amplifies a difference), so
+        the horizon is short, and the reference is checked by computing it a second way (dt 1/960:
+        other step boundaries, so other round-off and other TOI brackets) over REF_CHECK_T s."""
+        seeds = (1,) if self.quick else (1, 2, 3)
+        out: dict[str, Any] = {"horizon": REF_T, "check_horizon": REF_CHECK_T, "settings": REF_SETTINGS}
+        for g in (0.0, 9.8):
+            tasks = []
+            for sd in seeds:
+                sc = scenes.seed(20, g, sd, duration=REF_T)
+                long = scenes.seed(20, g, sd, duration=REF_CHECK_T)
+                tasks += [Task("libcollide", long, 1 / 60, REF_SETTINGS, 1 / 60, self.budget, "reference"),
+                          Task("libcollide", long, 1 / 960, REF_SETTINGS, 1 / 60, self.budget, "reference check")]
+                for dt in DTS[:2] if self.quick else DTS:
+                    for eng in ALL:
+                        for label, settings, dts in WP_VARIANTS[eng]:
+                            if dt in dts and (not self.quick or label == eng):
+                                tasks.append(Task(eng, sc, dt, settings, 1 / 60, self.budget, label))
+            log(f"trajectory reference g={g}: {len(tasks)} runs")
+            res = harness.run_interleaved(self.pool, tasks, 1, log)
+            refs = {r["scene"]: r for r in res.values() if r["label"] == "reference" and r.get("status") == "ok"}
+            checks = {r["scene"]: r for r in res.values() if r["label"] == "reference check"
+                      and r.get("status") == "ok"}
+            # 10 s costs of the same settings from section (1), where it ran (its repeats are the timed ones)
+            wp_cost = {(r["label"], r["dt"]): r["cost"] for r in self.out.get("wp", {}).get(f"g{g:g}", [])}
+            check = []
+            for name, r in refs.items():
+                c = checks.get(name)
+                if c is not None and metrics.finite(c) and metrics.finite(r):
+                    t = r["times"]
+                    check.append({"scene": name, "err": {f"{h:g}": metrics.trajectory_error(
+                        c["states"][t <= h + 1e-9], r["states"][t <= h + 1e-9], HALF_DIAGONAL)
+                        for h in REF_CHECK_AT}})
+            pts: dict[tuple[str, float], list[dict[str, Any]]] = {}
+            for r in res.values():
+                if r["label"].startswith("reference"):
+                    continue
+                ref_run = refs.get(r["scene"])
+                e = math.nan
+                if ref_run is not None and r.get("status") == "ok" and metrics.finite(r):
+                    e = metrics.trajectory_error(r["states"], ref_run["states"], HALF_DIAGONAL)
+                pts.setdefault((r["label"], r["dt"]), []).append({**strip(r), "traj_err": e})
+            rows = []
+            for (label, dt), runs in pts.items():
+                ok = [x["traj_err"] for x in runs if not math.isnan(x["traj_err"])]
+                own = float(np.median([x["cpu_per_sim_s"] for x in runs if "cpu_per_sim_s" in x]))
+                rows.append({"label": label, "engine": runs[0]["engine"], "dt": dt, "runs": len(runs),
+                             "failed": [x["status"] for x in runs if math.isnan(x["traj_err"])],
+                             "traj_err": float(np.median(ok)) if ok else math.nan, "traj_errs": ok,
+                             "cost": wp_cost.get((label, dt), own),
+                             "cost_from": "wp" if (label, dt) in wp_cost else "own"})
+            out[f"g{g:g}"] = {"rows": rows, "check": check}
+        self.out["ref"] = out
 
     # ---- single impacts and the flat drop ------------------------------------------------------
     def impacts(self) -> None:
@@ -272,7 +337,7 @@ def main() -> int:
     g = ap.add_mutually_exclusive_group()
     g.add_argument("--quick", action="store_true", help="1-2 minute smoke run (1 seed, 1 repeat, short scenes)")
     g.add_argument("--full", action="store_true", help="more repeats, larger scenes, longer budgets")
-    ap.add_argument("--sections", default="wp,impacts,cradle,tunnel,stacks,hard,pyramid,scaling")
+    ap.add_argument("--sections", default="wp,ref,impacts,cradle,tunnel,stacks,hard,pyramid,scaling")
     ap.add_argument("--out", default=os.path.join(ROOT, "docs", "benchmarks.md"),
                     help="markdown file to write; the plots go to img/ next to it")
     ap.add_argument("--budget", type=float, help="CPU seconds per run before it is stopped (default 15, quick 4, full 60)")

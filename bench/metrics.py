@@ -110,3 +110,15 @@ def hard_metrics(scene: Any, res: dict[str, Any]) -> dict[str, Any]:
         out["sink"] = float(s[0, -1, 1] - s[-1, -1, 1])
         out["dx"] = float(s[-1, -1, 0] - s[0, -1, 0])
     return out
+
+
+def trajectory_error(states: np.ndarray, ref: np.ndarray, half_diagonal: float) -> float:
+    """Largest distance (m) any point of any block strays from the reference over the common samples:
+    max over samples and blocks of |centre - centre_ref| + r |angle - angle_ref|, r = the block's
+    half-diagonal (a bound on every point's displacement). Both (k, n, 6), sampled at the same times.
+    Angles are compared modulo 2 pi: engines that keep a rotation as cos/sin report it in (-pi, pi]."""
+    k = min(len(states), len(ref))
+    a, b = np.asarray(states[:k]), np.asarray(ref[:k])
+    turn = np.abs(np.remainder(a[..., 2] - b[..., 2] + np.pi, 2 * np.pi) - np.pi)
+    d = np.hypot(a[..., 0] - b[..., 0], a[..., 1] - b[..., 1]) + half_diagonal * turn
+    return float(np.max(d))

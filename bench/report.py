@@ -59,24 +59,27 @@ def _plt() -> Any:
     return plt
 
 
-def plot_wp(rows: list[dict[str, Any]], title: str, path: str) -> None:
+def plot_wp(rows: list[dict[str, Any]], title: str, path: str, key: str = "abs_drift",
+            ylabel: str = "|relative energy drift| after 10 s (median of seeds)",
+            target: tuple[float, str] | None = (1e-9, "issue 4 target 1e-9")) -> None:
+    """Error (rows[key]) against cost, one line per engine over dt, variants as triangles."""
     plt = _plt()
     fig, ax = plt.subplots(figsize=(7.5, 5.2), dpi=110)
     for eng in ENGINES:
-        base = sorted([r for r in rows if r["label"] == eng and not math.isnan(r["abs_drift"])],
+        base = sorted([r for r in rows if r["label"] == eng and not math.isnan(r[key])],
                       key=lambda r: -r["dt"])
         if base:
             x = [r["cost"] * 1e3 for r in base]
-            y = [max(r["abs_drift"], FLOOR) for r in base]
+            y = [max(r[key], FLOOR) for r in base]
             ax.plot(x, y, "-o", color=COLORS[eng], label=NAMES[eng] + " (dt 1/60 → 1/960)")
             for r, xi, yi in zip(base, x, y):
                 ax.annotate(f"1/{round(1 / r['dt'])}", (xi, yi), fontsize=6, color=COLORS[eng],
                             textcoords="offset points", xytext=(3, 3))
-        var = [r for r in rows if r["engine"] == eng and r["label"] != eng and not math.isnan(r["abs_drift"])]
+        var = [r for r in rows if r["engine"] == eng and r["label"] != eng and not math.isnan(r[key])]
         for r in var:
-            ax.plot(r["cost"] * 1e3, max(r["abs_drift"], FLOOR), "^", color=COLORS[eng], mfc="none")
+            ax.plot(r["cost"] * 1e3, max(r[key], FLOOR), "^", color=COLORS[eng], mfc="none")
             ax.annotate(r["label"].replace(eng, "").strip() + f" 1/{round(1 / r['dt'])}",
-                        (r["cost"] * 1e3, max(r["abs_drift"], FLOOR)), fontsize=6, color=COLORS[eng],
+                        (r["cost"] * 1e3, max(r[key], FLOOR)), fontsize=6, color=COLORS[eng],
                         textcoords="offset points", xytext=(3, -8))
     ax.set_xscale("log")
     ax.set_yscale("log")
@@ -85,9 +88,10 @@ def plot_wp(rows: list[dict[str, Any]], title: str, path: str) -> None:
     ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
     ax.xaxis.set_minor_formatter(NullFormatter())
     ax.set_xlabel("CPU time per simulated second (ms), median of repeats")
-    ax.set_ylabel("|relative energy drift| after 10 s (median of seeds)")
-    ax.axhline(1e-9, color="grey", lw=0.7, ls=":")
-    ax.text(ax.get_xlim()[0], 1.3e-9, " issue 4 target 1e-9", fontsize=7, color="grey")
+    ax.set_ylabel(ylabel)
+    if target is not None:
+        ax.axhline(target[0], color="grey", lw=0.7, ls=":")
+        ax.text(ax.get_xlim()[0], 1.3 * target[0], " " + target[1], fontsize=7, color="grey")
     ax.set_title(title, fontsize=10)
     ax.grid(True, which="major", alpha=0.3)
     ax.legend(fontsize=7, loc="center right")
@@ -149,20 +153,20 @@ def wp_table(rows: list[dict[str, Any]]) -> list[str]:
     return out
 
 
-def front(rows: list[dict[str, Any]], eng: str, level: float) -> dict[str, Any] | None:
-    ok = [r for r in rows if r["engine"] == eng and not math.isnan(r["abs_drift"]) and r["abs_drift"] <= level
-          and not r["failed"]]
+def front(rows: list[dict[str, Any]], eng: str, level: float, key: str = "abs_drift") -> dict[str, Any] | None:
+    ok = [r for r in rows if r["engine"] == eng and not math.isnan(r[key]) and r[key] <= level and not r["failed"]]
     return min(ok, key=lambda r: r["cost"]) if ok else None
 
 
-def ratio_table(rows: list[dict[str, Any]]) -> list[str]:
+def ratio_table(rows: list[dict[str, Any]], key: str = "abs_drift", levels: tuple[float, ...] = LEVELS,
+                unit: str = "") -> list[str]:
     out = ["| error level | libcollide cheapest (ms / sim. s) | " + " | ".join(
         f"{NAMES[e]}: cheapest, ratio to libcollide" for e in ENGINES[1:]) + " |", "|---|---|" + "---|" * 3]
-    for lv in LEVELS:
-        lc = front(rows, "libcollide", lv)
+    for lv in levels:
+        lc = front(rows, "libcollide", lv, key)
         cells = [f"{f(lc['cost'] * 1e3)} ({lc['label']}, 1/{round(1 / lc['dt'])})" if lc else "not reached"]
         for e in ENGINES[1:]:
-            p = front(rows, e, lv)
+            p = front(rows, e, lv, key)
             if p is None:
                 cells.append("not reached")
             elif lc is None:
@@ -170,7 +174,7 @@ def ratio_table(rows: list[dict[str, Any]]) -> list[str]:
             else:
                 cells.append(f"{f(p['cost'] * 1e3)} ms ({p['label']}, 1/{round(1 / p['dt'])}): "
                              f"**{p['cost'] / lc['cost']:.2g}x**")
-        out.append(f"| ≤ {lv:g} | " + " | ".join(cells) + " |")
+        out.append(f"| ≤ {lv:g}{unit} | " + " | ".join(cells) + " |")
     return out
 
 
@@ -190,6 +194,27 @@ def stages_line(st: dict[str, Any]) -> str:
     return "ran: " + ", ".join(ran) + ("; skipped: " + ", ".join(off) if off else "")
 
 
+def traj_table(rows: list[dict[str, Any]]) -> list[str]:
+    dts = sorted({r["dt"] for r in rows if r["label"] in ENGINES}, reverse=True)
+    out = ["| dt | " + " | ".join(f"{NAMES[e]}: error (m, range over seeds) / ms per sim. s" for e in ENGINES) + " |",
+           "|---|" + "---|" * len(ENGINES)]
+
+    def cell(r: dict[str, Any]) -> str:
+        errs = r.get("traj_errs", [])
+        rng = f" ({f(min(errs), '.2g')} … {f(max(errs), '.2g')})" if len(errs) > 1 else ""
+        return (f"{f(r['traj_err'], '.2g')}{rng} / {f(r['cost'] * 1e3)}"
+                + (f" ({', '.join(r['failed'])})" if r["failed"] else ""))
+    for dt in dts:
+        cells = [next((cell(r) for r in rows if r["label"] == e and r["dt"] == dt), "—") for e in ENGINES]
+        out.append(f"| 1/{round(1 / dt)} | " + " | ".join(cells) + " |")
+    var = [r for r in rows if r["label"] not in ENGINES]
+    if var:
+        out += ["", "Variants (median error / cost): " + "; ".join(
+            f"{r['label']} at 1/{round(1 / r['dt'])}: {f(r['traj_err'], '.2g')} m / {f(r['cost'] * 1e3)} ms"
+            for r in var) + "."]
+    return out
+
+
 # ---- document ----------------------------------------------------------------------------------
 def write(out: dict[str, Any], path: str, img_dir: str) -> None:
     os.makedirs(img_dir, exist_ok=True)
@@ -202,7 +227,7 @@ def write(out: dict[str, Any], path: str, img_dir: str) -> None:
           "bench/run            # default run, about 10 min on a 2-core VM",
           "bench/run --quick    # 1-2 min smoke run (1 seed, 1 repeat, short scenes)",
           "bench/run --full     # 5 repeats, pyramid base 100, up to 5000 bodies, 60 s CPU budgets",
-          "bench/run --sections wp,impacts   # only these (of wp,impacts,cradle,tunnel,stacks,hard,pyramid,scaling);",
+          "bench/run --sections wp,impacts   # only these (of wp,ref,impacts,cradle,tunnel,stacks,hard,pyramid,scaling);",
           "                                   # the page then holds only them: use --out /tmp/x.md to keep this one",
           "bench/run --lib /path/to/build     # measure the libcollide.so of another build (first argument)",
           "bench/run --budget 60              # CPU seconds per run before it is stopped",
@@ -290,6 +315,46 @@ def write(out: dict[str, Any], path: str, img_dir: str) -> None:
                                  f"{f(float(np.median([r['us_per_step'] for r in rs])))} µs/step" if rs else "—")
                 L.append(f"| {g:g} | " + " | ".join(cells) + " |")
             L += ["", "(median abs drift over seeds / median µs per 1/60 s step)", ""]
+
+    ref = out.get("ref")
+    if ref:
+        L += ["## (1b) Seed scene: trajectory error against a converged reference", "",
+              f"The same scenes (seeds as in (1)) for the first {ref['horizon']:g} s, states sampled every 1/60 s, "
+              "compared with a reference: libcollide at its tightest time-of-impact tolerances "
+              f"(toi_time_tolerance {ref['settings']['toi_time_tolerance']:g} s, toi_distance_tolerance "
+              f"{ref['settings']['toi_distance_tolerance']:g} m) at dt 1/60. error = the farthest any point of "
+              "any block strays from the reference over the samples: max over samples and blocks of "
+              "|Δcentre| + r |Δangle| (r = the block's half-diagonal, 0.559 m; a bound on every point's "
+              "displacement), median over seeds. The scene is chaotic: each block-block impact amplifies a "
+              "difference, so the horizon is short. The reference is checked by computing it a second way, "
+              "at dt 1/960 (other step boundaries, so other round-off and other time-of-impact brackets); "
+              "the check line gives how far the two computations are apart, which bounds what this table can "
+              "resolve. Cost = the same setting's CPU ms per simulated second from the 10 s runs of (1)"
+              " (from these short runs where (1) did not run).", ""]
+        for g in ("g0", "g9.8"):
+            sec_g = ref.get(g)
+            if not sec_g:
+                continue
+            rows, check = sec_g["rows"], sec_g["check"]
+            gv = g[1:]
+            fn = f"bench_ref_{g.replace('.', '_')}.png"
+            hz = f"{ref['horizon']:g}"
+            floor = max((c["err"][hz] for c in check if hz in c["err"]), default=None)
+            plot_wp(rows, f"Seed scene, 20 blocks, g = {gv} m/s²: error against the reference over "
+                    f"{ref['horizon']:g} s", os.path.join(img_dir, fn), key="traj_err",
+                    ylabel=f"farthest point displacement from the reference over {ref['horizon']:g} s (m)",
+                    target=None if floor is None else (max(floor, FLOOR), f"reference computed twice: {floor:.1g} m apart"))
+            L += [f"### g = {gv} m/s²", "", f"![trajectory error g={gv}]({rel}/{fn})", ""]
+            L += traj_table(rows) + [""]
+            if check:
+                at = list(check[0]["err"].keys())
+                L += ["Reference check (dt 1/960 against dt 1/60, largest over seeds): " + ", ".join(
+                    f"{f(max(c['err'][h] for c in check), '.2g')} m by {h} s" for h in at) + ".", ""]
+            else:
+                L += ["Reference check: did not run to the end (see `bench/results/latest.json`).", ""]
+            L += ["Speed ratio at each error level (cheapest setting whose error is within the level; ratio = "
+                  "peer cost / libcollide cost, > 1 means libcollide is faster):", ""]
+            L += ratio_table(rows, "traj_err", (1e-1, 1e-2, 1e-3, 1e-6, 1e-9), " m") + [""]
 
     imp = out.get("impacts")
     if imp:
