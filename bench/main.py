@@ -45,7 +45,7 @@ WP_VARIANTS: dict[str, list[tuple[str, dict, tuple[float, ...]]]] = {
                                      DTS[:1])],
 }
 # Trajectory reference (section "ref"): libcollide at its tightest TOI tolerances. Computed at dt 1/60
-# and at 1/960, seeds 1-3 (run of 2026-11-23 12:05, docs/benchmarks.md (1b)), it agrees with itself to
+# and at 1/960, seeds 1-3 (run of 2026-11-23 12:12, docs/benchmarks.md (1b)), it agrees with itself to
 # 2.6e-12 m over 0.5 s, but at 1 s one g = 9.8 seed is 1.7 m apart and by 2 s all are metres apart
 # (chaos), so REF_T = 0.5 s; the check runs to 2 s so that every run shows where the horizon stands.
 REF_T = 0.5
@@ -205,13 +205,19 @@ class Bench:
     def impacts(self) -> None:
         cases = [(scenes.wall_hit(3.0, 0.0), (1 / 60, 1 / 240)), (scenes.wall_hit(3.0, math.radians(30)), (1 / 60,)),
                  (scenes.flat_drop(), (1 / 60, 1 / 240))]
+        fly = scenes.free_flight()
         tasks = [Task(eng, sc, dt, {}, None, self.budget) for sc, dts in cases for dt in dts for eng in ALL]
+        tasks += [Task(eng, fly, dt, {}, 1 / 60, self.budget) for dt in (1 / 60, 1 / 240) for eng in ALL]
         log(f"impacts: {len(tasks)} runs")
         res = self.run(tasks)
         rows = []
         for r in res.values():
+            ok = r.get("status") == "ok" and metrics.finite(r)
+            if r["scene"] == fly.name:
+                rows.append({**strip(r), **(metrics.free_flight_metrics(fly, r) if ok else {})})
+                continue
             sc = next(sc for sc, _ in cases if sc.name == r["scene"])
-            m = metrics.impact_metrics(sc, r) if r.get("status") == "ok" and metrics.finite(r) else {}
+            m = metrics.impact_metrics(sc, r) if ok else {}
             rows.append({**strip(r), **m})
         self.out["impacts"] = rows
 
@@ -335,7 +341,7 @@ class Bench:
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     g = ap.add_mutually_exclusive_group()
-    g.add_argument("--quick", action="store_true", help="1-2 minute smoke run (1 seed, 1 repeat, short scenes)")
+    g.add_argument("--quick", action="store_true", help="smoke run of a few seconds (1 seed, 1 repeat, short scenes)")
     g.add_argument("--full", action="store_true", help="more repeats, larger scenes, longer budgets")
     ap.add_argument("--sections", default="wp,ref,impacts,cradle,tunnel,stacks,hard,pyramid,scaling")
     ap.add_argument("--out", default=os.path.join(ROOT, "docs", "benchmarks.md"),

@@ -62,6 +62,23 @@ def impact_metrics(scene: Any, res: dict[str, Any]) -> dict[str, Any]:
             "vy": float(s[-1, 0, 4])}
 
 
+def free_flight_metrics(scene: Any, res: dict[str, Any]) -> dict[str, Any]:
+    """One body without contacts against the closed form: position error bound over the samples
+    (trajectory_error against the exact states) and the relative energy change."""
+    b, t, s = scene.dynamic[0], np.asarray(res["times"]), res["states"]
+    exact = np.zeros((len(t), 1, 6))
+    exact[:, 0, 0] = b.x + b.vx * t
+    exact[:, 0, 1] = b.y + b.vy * t - 0.5 * scene.gravity * t * t
+    exact[:, 0, 2] = b.angle + b.omega * t
+    exact[:, 0, 3] = b.vx
+    exact[:, 0, 4] = b.vy - scene.gravity * t
+    exact[:, 0, 5] = b.omega
+    e = energy(scene, s)
+    return {"pos_err": trajectory_error(s, exact, math.hypot(b.w, b.h) / 2),
+            "vel_err": float(np.max(np.abs(s[..., 3:5] - exact[..., 3:5]))),
+            "e_change": float((e[-1] - e[0]) / e[0])}
+
+
 def stack_metrics(scene: Any, res: dict[str, Any]) -> dict[str, Any]:
     s, t = res["states"], res["times"]
     top0, top = s[0, -1], s[:, -1]

@@ -224,9 +224,9 @@ def write(out: dict[str, Any], path: str, img_dir: str) -> None:
     L += ["# Benchmarks: speed against error (issue 4)", "",
           "Regenerate everything on this page (tables, plots, `bench/results/latest.json`) with one command "
           "from the repository root:", "", "```bash",
-          "bench/run            # default run, about 10 min on a 2-core VM",
-          "bench/run --quick    # 1-2 min smoke run (1 seed, 1 repeat, short scenes)",
-          "bench/run --full     # 5 repeats, pyramid base 100, up to 5000 bodies, 60 s CPU budgets",
+          "bench/run            # default run, about 1 min on a 2-core VM (3 repeats)",
+          "bench/run --quick    # smoke run of a few seconds (1 seed, 1 repeat, short scenes)",
+          "bench/run --full     # about 5 min: 5 repeats, pyramid base 100, up to 5000 bodies, 60 s CPU budgets",
           "bench/run --sections wp,impacts   # only these (of wp,ref,impacts,cradle,tunnel,stacks,hard,pyramid,scaling);",
           "                                   # the page then holds only them: use --out /tmp/x.md to keep this one",
           "bench/run --lib /path/to/build     # measure the libcollide.so of another build (first argument)",
@@ -358,7 +358,7 @@ def write(out: dict[str, Any], path: str, img_dir: str) -> None:
 
     imp = out.get("impacts")
     if imp:
-        L += ["## (9) Single impacts and the flat drop", "",
+        L += ["## (9) Single impacts, the flat drop and free flight", "",
               "Face-on wall hit at 3 m/s (2-point manifold; exact: v' = −3, ω' = 0), corner hit with the block "
               "turned 30°, and a block dropped flat from 2 m onto the floor (g 9.8, exact: E ratio 1, ω 0), "
               "e = 1, μ = 0; states read 1 s after the start (after the single bounce).", "",
@@ -380,6 +380,22 @@ def write(out: dict[str, Any], path: str, img_dir: str) -> None:
                            f"{max(errs):.2g}, max abs(ω') {max(spin) if spin else math.nan:.2g} rad/s | "
                            f"{'yes' if max(errs) <= 1e-9 and (not spin or max(spin) <= 1e-9) else 'NO'} |")
         L += [""]
+        fly = [r for r in imp if r["scene"] == "free_flight"]
+        if fly:
+            L += ["Free flight: the block thrown at (3, 6) m/s with ω = 5 rad/s under g = 9.8, nothing to hit, "
+                  "1 s, states every 1/60 s against the closed form (parabola, angle linear in time). pos = the "
+                  "farthest any point of the block strays from it (|Δcentre| + r |Δangle|, r = 0.559 m), vel = "
+                  "largest velocity error, ΔE = relative energy change.", "",
+                  "| dt | " + " | ".join(NAMES[e] + ": pos (m), vel (m/s), ΔE" for e in ENGINES) + " |",
+                  "|---|" + "---|" * len(ENGINES)]
+            for dt in sorted({r["dt"] for r in fly}, reverse=True):
+                cells = []
+                for e in ENGINES:
+                    r = by(fly, "free_flight", e, dt)
+                    cells.append("—" if r is None or "pos_err" not in r else
+                                 f"{r['pos_err']:.2g}, {r['vel_err']:.2g}, {pct(r['e_change'])}" + status_cell(r))
+                L.append(f"| 1/{round(1 / dt)} | " + " | ".join(cells) + " |")
+            L += [""]
 
     cr = out.get("cradle")
     if cr:

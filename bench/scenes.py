@@ -99,6 +99,14 @@ def flat_drop(height: float = 2.0, duration: float = 1.0, g: float = 9.8) -> Sce
     return Scene("flat_drop", (Box(BLOCK_W, BLOCK_H, 0.0, height + BLOCK_H / 2), floor), gravity=g, duration=duration)
 
 
+def free_flight(vx: float = 3.0, vy: float = 6.0, omega: float = 5.0, angle: float = 0.3, duration: float = 1.0,
+                g: float = 9.8) -> Scene:
+    """A seed block thrown with spin, nothing to hit. Exact: a parabola, the angle linear in time, the
+    spin and the energy constant (metrics.free_flight_metrics)."""
+    b = Box(BLOCK_W, BLOCK_H, 0.0, 0.0, angle=angle, vx=vx, vy=vy, omega=omega)
+    return Scene("free_flight", (b,), gravity=g, duration=duration)
+
+
 def wall_hit(v: float = 3.0, angle: float = 0.0, duration: float = 1.0) -> Scene:
     """Single impact: a block at v m/s into a wall, face-on (angle 0: 2-point manifold) or on a corner.
     Exact: E ratio 1; face-on v' = -v, omega' = 0."""
