@@ -185,16 +185,18 @@ class Bench:
                 if r["label"].startswith("reference"):
                     continue
                 ref_run = refs.get(r["scene"])
-                e = math.nan
-                if ref_run is not None and r.get("status") == "ok" and metrics.finite(r):
+                e, why = math.nan, r.get("status", "?")
+                if ref_run is None:
+                    why = "no reference: it did not finish"
+                elif r.get("status") == "ok" and metrics.finite(r):
                     e = metrics.trajectory_error(r["states"], ref_run["states"], HALF_DIAGONAL)
-                pts.setdefault((r["label"], r["dt"]), []).append({**strip(r), "traj_err": e})
+                pts.setdefault((r["label"], r["dt"]), []).append({**strip(r), "traj_err": e, "why": why})
             rows = []
             for (label, dt), runs in pts.items():
                 ok = [x["traj_err"] for x in runs if not math.isnan(x["traj_err"])]
                 own = float(np.median([x["cpu_per_sim_s"] for x in runs if "cpu_per_sim_s" in x]))
                 rows.append({"label": label, "engine": runs[0]["engine"], "dt": dt, "runs": len(runs),
-                             "failed": [x["status"] for x in runs if math.isnan(x["traj_err"])],
+                             "failed": [x["why"] for x in runs if math.isnan(x["traj_err"])],
                              "traj_err": float(np.median(ok)) if ok else math.nan, "traj_errs": ok,
                              "cost": wp_cost.get((label, dt), own),
                              "cost_from": "wp" if (label, dt) in wp_cost else "own"})
