@@ -132,25 +132,37 @@ def plot_scaling(rows: list[dict[str, Any]], path: str) -> None:
 
 
 # ---- tables ------------------------------------------------------------------------------------
-def wp_table(rows: list[dict[str, Any]]) -> list[str]:
+def dt_table(rows: list[dict[str, Any]], key: str, seeds_key: str, fmt: Any, head: str, name: str,
+             unit: str = "") -> list[str]:
+    """Work-precision table: a row per dt, per engine the median error rows[key] (with its range over
+    the seeds, rows[seeds_key]) and the cost; the variants' settings in one line below."""
     dts = sorted({r["dt"] for r in rows if r["label"] in ENGINES}, reverse=True)
-    out = ["| dt | " + " | ".join(f"{NAMES[e]}: abs drift (range over seeds) / ms per sim. s" for e in ENGINES) + " |",
+    out = ["| dt | " + " | ".join(f"{NAMES[e]}: {head} / ms per sim. s" for e in ENGINES) + " |",
            "|---|" + "---|" * len(ENGINES)]
+
+    def cell(r: dict[str, Any]) -> str:
+        seeds = r.get(seeds_key, [])
+        rng = f" ({fmt(min(seeds))} … {fmt(max(seeds))})" if len(seeds) > 1 else ""
+        return (f"{fmt(r[key]).lstrip('+')}{rng} / {f(r['cost'] * 1e3)}"
+                + (f" ({', '.join(r['failed'])})" if r["failed"] else ""))
     for dt in dts:
-        cells = []
-        for e in ENGINES:
-            r = next((r for r in rows if r["label"] == e and r["dt"] == dt), None)
-            rng = ""
-            if r is not None and len(r.get("drifts", [])) > 1:
-                rng = f" ({pct(min(r['drifts']))} … {pct(max(r['drifts']))})"
-            cells.append("—" if r is None else f"{pct(r['abs_drift']).lstrip('+')}{rng} / {f(r['cost'] * 1e3)}"
-                         + (f" ({', '.join(r['failed'])})" if r["failed"] else ""))
+        cells = [next((cell(r) for r in rows if r["label"] == e and r["dt"] == dt), "—") for e in ENGINES]
         out.append(f"| 1/{round(1 / dt)} | " + " | ".join(cells) + " |")
     var = [r for r in rows if r["label"] not in ENGINES]
     if var:
-        out += ["", "Variants (median abs drift / cost): " + "; ".join(f"{r['label']} at 1/{round(1 / r['dt'])}: {pct(r['abs_drift']).lstrip('+')} / "
-                                              f"{f(r['cost'] * 1e3)} ms" for r in var) + "."]
+        out += ["", f"Variants (median {name} / cost): " + "; ".join(
+            f"{r['label']} at 1/{round(1 / r['dt'])}: {fmt(r[key]).lstrip('+')}{unit} / {f(r['cost'] * 1e3)} ms"
+            for r in var) + "."]
     return out
+
+
+def wp_table(rows: list[dict[str, Any]]) -> list[str]:
+    return dt_table(rows, "abs_drift", "drifts", pct, "abs drift (range over seeds)", "abs drift")
+
+
+def traj_table(rows: list[dict[str, Any]]) -> list[str]:
+    return dt_table(rows, "traj_err", "traj_errs", lambda x: f(x, ".2g"), "error (m, range over seeds)", "error",
+                    " m")
 
 
 def front(rows: list[dict[str, Any]], eng: str, level: float, key: str = "abs_drift") -> dict[str, Any] | None:
@@ -192,27 +204,6 @@ def stages_line(st: dict[str, Any]) -> str:
     ran = [f"{name} ({st[k] / steps:.3g}/step)" for k, name in STAGES if st.get(k, 0)]
     off = [name for k, name in STAGES if not st.get(k, 0)]
     return "ran: " + ", ".join(ran) + ("; skipped: " + ", ".join(off) if off else "")
-
-
-def traj_table(rows: list[dict[str, Any]]) -> list[str]:
-    dts = sorted({r["dt"] for r in rows if r["label"] in ENGINES}, reverse=True)
-    out = ["| dt | " + " | ".join(f"{NAMES[e]}: error (m, range over seeds) / ms per sim. s" for e in ENGINES) + " |",
-           "|---|" + "---|" * len(ENGINES)]
-
-    def cell(r: dict[str, Any]) -> str:
-        errs = r.get("traj_errs", [])
-        rng = f" ({f(min(errs), '.2g')} … {f(max(errs), '.2g')})" if len(errs) > 1 else ""
-        return (f"{f(r['traj_err'], '.2g')}{rng} / {f(r['cost'] * 1e3)}"
-                + (f" ({', '.join(r['failed'])})" if r["failed"] else ""))
-    for dt in dts:
-        cells = [next((cell(r) for r in rows if r["label"] == e and r["dt"] == dt), "—") for e in ENGINES]
-        out.append(f"| 1/{round(1 / dt)} | " + " | ".join(cells) + " |")
-    var = [r for r in rows if r["label"] not in ENGINES]
-    if var:
-        out += ["", "Variants (median error / cost): " + "; ".join(
-            f"{r['label']} at 1/{round(1 / r['dt'])}: {f(r['traj_err'], '.2g')} m / {f(r['cost'] * 1e3)} ms"
-            for r in var) + "."]
-    return out
 
 
 # ---- document ----------------------------------------------------------------------------------
