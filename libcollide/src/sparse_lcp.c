@@ -21,6 +21,17 @@
  * its 10 products. */
 #define LC_MPRGP_POWER_ITERATIONS 12
 #define LC_MPRGP_POWER_REFRESH 3
+/* A solve whose violation rises to this multiple of the kept iterate's has diverged: it stops and
+ * returns the kept iterate (one that came within 2x of the best violation so far).
+ * Why: MPRGP lowers the objective at every step, but only in exact arithmetic. A 5e-12 m decagon
+ * with a wall corner's touch 3e4 m from its centre (inverse inertia 8.6e21) gave its group
+ * ||A|| ~ 1e28 against a smallest scale ~0.1: past round-off, the expansion steps grew the
+ * violation to 1e28-1e153 m/s^2 in every solve until the budget, and one step took 142 s to reach
+ * the evaluation cap (fuzz finding 31; 0.01 s with this). The violation of a sound solve is not
+ * monotone either: in the seven scenes of bench/repro/same_bits.c (790 000 solves) it rose at most
+ * 1e5-1e6 times above its best, so 1e8 stops only what no sound solve does, and those scenes keep
+ * every bit. */
+#define LC_MPRGP_DIVERGED 1e8
 
 /* clamps without libm calls (fmin/fmax keep NaN rules and are not inlined): x is finite here */
 static double clamp(double x, double lo, double hi)
@@ -189,8 +200,8 @@ int lc_sparse_lcp(lc_world *w, const lc_touch *t, int m, int tangent, const doub
                   const double *hi, double *x, double tol, int max_products, double *violation)
 {
     double *body = lc_buf_get(&w->b_sparse_body, (size_t)w->count * 3 * sizeof(double));
-    double *g = lc_buf_get(&w->b_sparse, (size_t)m * 6 * sizeof(double));
-    double *p, *ap, *phi, *beta, *d, alpha, lambda, worst, bb, pp;
+    double *g = lc_buf_get(&w->b_sparse, (size_t)m * 7 * sizeof(double));
+    double *p, *ap, *phi, *beta, *d, *kept, alpha, lambda, worst, kept_worst, bb, pp;
     sparse_row *rows;
     int i, products = 0, restarted = 0, refreshed = 0;
     if (body == NULL || g == NULL) return -1;
@@ -206,6 +217,7 @@ int lc_sparse_lcp(lc_world *w, const lc_touch *t, int m, int tangent, const doub
     phi = ap + m;
     beta = phi + m;
     d = beta + m;
+    kept = d + m;
     if (w->sparse_norm_rows[tangent != 0] == m) {
         lambda = w->sparse_norm[tangent != 0];
     } else {
@@ -242,7 +254,18 @@ int lc_sparse_lcp(lc_world *w, const lc_touch *t, int m, int tangent, const doub
     for (i = 0; i < m; ++i) g[i] += b[i];
     worst = gradients(x, g, lo, hi, m, alpha, phi, beta, &bb, &pp);
     memcpy(p, phi, (size_t)m * sizeof(double));
+    memcpy(kept, x, (size_t)m * sizeof(double));
+    kept_worst = worst;
     while (worst > tol && products < max_products) {
+        /* kept only at halvings: a few copies per solve, not one per step */
+        if (worst < 0.5 * kept_worst) {
+            memcpy(kept, x, (size_t)m * sizeof(double));
+            kept_worst = worst;
+        } else if (!(worst <= LC_MPRGP_DIVERGED * kept_worst)) {   /* NaN too */
+            memcpy(x, kept, (size_t)m * sizeof(double));
+            worst = kept_worst;
+            break;
+        }
         if (bb <= LC_MPRGP_GAMMA * LC_MPRGP_GAMMA * pp) {
             double pap, gp, acg, af;
             product(w, rows, m, p, body, ap);

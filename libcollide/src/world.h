@@ -216,7 +216,8 @@ static inline lc_vec2 lc_tangent_of(lc_vec2 n) { return lc_v(-n.y, n.x); }
 /* ---- sparse_lcp.c ---- */
 /* MPRGP on min 1/2 x'Ax + b'x, lo <= x <= hi, with A = J M^-1 J' of the touches' normal (or, with
  * tangent != 0, tangent) rows, never formed. x: start and answer. Returns products of A used (-1: no
- * memory); *violation = largest entry of the projected gradient (units of b). */
+ * memory); *violation = largest entry of the projected gradient (units of b). A solve that diverges
+ * (round-off past its matrix's scale) stops with the best iterate it kept. */
 int lc_sparse_lcp(lc_world *w, const lc_touch *t, int m, int tangent, const double *b, const double *lo,
                   const double *hi, double *x, double tol, int max_products, double *violation);
 
