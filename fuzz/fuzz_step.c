@@ -8,9 +8,10 @@
  * Invariants checked (a violation calls fz_fail(), which aborts the harness, never the library):
  *  - every call either returns LC_OK or returns an error with a non-empty lc_world_last_error(),
  *    and a failed call leaves the state hash unchanged ("the world is unchanged on failure");
- *  - a step, successful or failed, needs at most FZ_MAX_FORCE_EVALS force evaluations and
- *    FZ_MAX_SERIAL_ITERS serial impulse iterations (work, not wall time: the verdict is the same on
- *    any machine, under any load, with or without sanitizers);
+ *  - a step, successful or failed, needs at most FZ_MAX_FORCE_EVALS force evaluations,
+ *    FZ_MAX_SERIAL_ITERS serial impulse iterations and FZ_MAX_SOLVER_WORK_PER_BODY solver work per body
+ *    (work, not wall time: the verdict is the same on any machine, under any load, with or without
+ *    sanitizers);
  *  - after every step (successful or not): time and every state number are finite, and no two
  *    bodies (except static-static pairs, which the engine never separates) overlap by more than
  *    FZ_OVERLAP_TOL + round-off, measured here with our own separating-axis test on the world
@@ -51,6 +52,12 @@
  * cap, about one pass each); 1e5 is seconds of CPU under ASan. */
 #ifndef FZ_MAX_SERIAL_ITERS
 #define FZ_MAX_SERIAL_ITERS 100000ULL
+#endif
+/* The cost of those evaluations and passes: matrix entries the complementarity solves visited
+ * (lc_counters.solver_work), per body of the world. The engine undoes a step past 1e9 per body
+ * (libcollide/src/step.c); twice that means its cap failed to stop one (finding 32: 1.7e10, 110 s). */
+#ifndef FZ_MAX_SOLVER_WORK_PER_BODY
+#define FZ_MAX_SOLVER_WORK_PER_BODY 2e9
 #endif
 /* Long-run mode (fuzz/run --budget N compiles with -DFZ_INPUT_BUDGET=N): once an input has done N units
  * of work in all (force evaluations + time-of-impact iterations + serial impulse passes, the counters
@@ -512,6 +519,11 @@ static void fz_step(fz_in *in, fz_ctx *c)
                 snprintf(msg, sizeof msg, "%llu serial impulse iterations in %s", (unsigned long long)last.serial_iterations,
                          after);
                 fz_fail("one step took more than FZ_MAX_SERIAL_ITERS serial impulse iterations", msg);
+            }
+            if ((double)last.solver_work > FZ_MAX_SOLVER_WORK_PER_BODY * (double)lc_world_body_count(c->w)) {
+                snprintf(msg, sizeof msg, "solver work %.3g with %d bodies in %s", (double)last.solver_work,
+                         lc_world_body_count(c->w), after);
+                fz_fail("one step's solves took more than FZ_MAX_SOLVER_WORK_PER_BODY per body", msg);
             }
         }
         if (s != LC_OK) break;

@@ -12,6 +12,10 @@
 #include <string.h>
 #include "world.h"
 
+/* Entries of A = J M^-1 J^T one row of a product visits: a touch's row of J has 6 (3 per body), read
+ * once in J^T x and once in J; the unit of lc_counters.solver_work (a dense pivot visits m per row). */
+#define LC_SPARSE_ROW_ENTRIES 12u
+
 /* Proportioning constant: release bound rows when their chopped gradient outweighs the free one. */
 #define LC_MPRGP_GAMMA 1.0
 /* Power iterations that estimate ||A|| for the expansion step length: from scratch, and when the
@@ -242,6 +246,7 @@ int lc_sparse_lcp(lc_world *w, const lc_touch *t, int m, int tangent, const doub
         for (i = 0; i < m; ++i) x[i] = b[i] > 0.0 ? lo[i] : b[i] < 0.0 ? hi[i] : fmin(fmax(x[i], lo[i]), hi[i]);
         for (i = 0; i < m; ++i) if (!isfinite(x[i])) x[i] = 0.0;
         *violation = 0.0;
+        w->last.solver_work += (uint64_t)products * (uint64_t)m * LC_SPARSE_ROW_ENTRIES;
         return products;
     }
     /* the expansion step length: Dostal's bound is 2/||A||; the power estimate is from below (a few
@@ -356,5 +361,6 @@ int lc_sparse_lcp(lc_world *w, const lc_touch *t, int m, int tangent, const doub
         worst = kept_worst;
     }
     *violation = worst;
+    w->last.solver_work += (uint64_t)products * (uint64_t)m * LC_SPARSE_ROW_ENTRIES;
     return products;
 }

@@ -19,6 +19,15 @@
 #ifndef LC_MAX_SERIAL_ITERATIONS_PER_STEP
 #define LC_MAX_SERIAL_ITERATIONS_PER_STEP 50000
 #endif
+/* and the complementarity solves' work (lc_counters.solver_work), per body of the world: one force
+ * evaluation of four coincident decagons (a 120-row dense group) costs 150 of the settling scene's
+ * (20 blocks), so evaluations alone let such a step run 110 s to their cap (fuzz finding 32).
+ * Measured per body (bench/repro/solver_work_per_body.py): the hardest legitimate step, a box dropped
+ * onto a 78-box frictional pyramid, does 1.1e8 (10.5 s of CPU), the bench scenes at most 3e5; that
+ * input did 1.7e10 by the evaluation cap, and now stops at 1e9 after 4 s. */
+#ifndef LC_MAX_SOLVER_WORK_PER_BODY
+#define LC_MAX_SOLVER_WORK_PER_BODY 1000000000
+#endif
 /* The caps can be lowered at build time (-DLC_MAX_...=N, a plain decimal number): fuzz/run --engine-cap
  * does so, so that the fuzzer does not spend seconds on each input that ends at a cap anyway. */
 #define LC_STRINGIFY_(x) #x
@@ -320,6 +329,7 @@ static void add_counters(lc_counters *total, const lc_counters *last)
     total->resting_contacts += last->resting_contacts;
     total->contact_solves += last->contact_solves;
     total->contact_solve_iterations += last->contact_solve_iterations;
+    total->solver_work += last->solver_work;
     total->impulse_solves += last->impulse_solves;
     total->position_projections += last->position_projections;
     total->quiet_advances += last->quiet_advances;
@@ -414,6 +424,7 @@ static int project_once(lc_world *w, double *deepest, int *found)
     opt.max_iterations = w->def.lcp_max_iterations;
     opt.tolerance = w->def.lcp_tolerance;
     lc_lcp_solve(n, A, b, lam, NULL, &opt, w->lcp, &res);
+    w->last.solver_work += ((uint64_t)res.iterations + 2) * (uint64_t)n * (uint64_t)n;
     for (i = 0; i < n; ++i) {
         double l = lam[i] > 0.0 && isfinite(lam[i]) ? lam[i] : 0.0;
         if (l > 0.0) lc_touch_apply(w, &t[i], lc_scale(t[i].n, l), w->state, 6);
@@ -911,6 +922,10 @@ lc_status lc_world_step(lc_world *w, double dt)
                                "the step needed more than " LC_STRINGIFY(LC_MAX_FORCE_EVALUATIONS_PER_STEP)
                                " force evaluations or " LC_STRINGIFY(LC_MAX_SERIAL_ITERATIONS_PER_STEP)
                                " serial impulse passes (stiff forces or extreme speeds?)");
+        if ((double)w->last.solver_work > (double)LC_MAX_SOLVER_WORK_PER_BODY * (double)w->count)
+            return step_failed(w, backup, time0, LC_ERR_NUMERIC,
+                               "the step's contact and impulse solves needed more than " LC_STRINGIFY(LC_MAX_SOLVER_WORK_PER_BODY)
+                               " matrix entries per body (lc_counters.solver_work; bodies piled onto one spot?)");
         /* After an impact in free flight (nothing resting, no spring between bodies, the same trial
          * end), only the bodies of that impact move differently: every other body keeps its trial
          * path to the previous trial's end, and the crossings found between two such bodies stay

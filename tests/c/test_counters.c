@@ -54,6 +54,7 @@ static void nothing_touches(void)
     CHECK(tot.toi_searches == 0, "no TOI search when nothing collides (%llu)", (unsigned long long)tot.toi_searches);
     CHECK(tot.collisions == 0 && tot.impulses == 0 && tot.impulse_solves == 0, "%s", "no collisions or impulses");
     CHECK(tot.resting_contacts == 0, "%s", "no resting contacts");
+    CHECK(tot.solver_work == 0, "no solver work without a solve (%llu)", (unsigned long long)tot.solver_work);
     CHECK(tot.force_evaluations == 0, "no force of any kind -> no force evaluations (%llu)",
           (unsigned long long)tot.force_evaluations);
     CHECK(tot.analytic_advances > 0, "%s", "free flight advanced in closed form");
@@ -73,6 +74,9 @@ static void resting_is_counted(void)
     CHECK(tot.contact_solves > 0, "a block resting on the floor needs contact solves (%llu)",
           (unsigned long long)tot.contact_solves);
     CHECK(tot.resting_contacts > 0, "%s", "resting contacts counted");
+    /* a dense solve of m rows visits m^2 entries at least twice (set-up and answer) */
+    CHECK(tot.solver_work >= 2 * tot.contact_solves, "solver work counted (%llu for %llu solves)",
+          (unsigned long long)tot.solver_work, (unsigned long long)tot.contact_solves);
     CHECK(tot.force_evaluations + tot.analytic_advances > 0, "%s", "the body was advanced");
     lc_world_destroy(w);
 }
@@ -332,6 +336,9 @@ static void pile_in_motion(int exact_max, double bound)
           "force solves within %g products per evaluation (%llu products, %llu evaluations)", bound,
           (unsigned long long)tot.contact_solve_iterations, (unsigned long long)tot.force_evaluations);
     CHECK(isfinite(tot.max_lcp_residual), "%s", "the residual is a number");
+    /* every pivot visits a row of m entries per row, every sparse product 12 per row */
+    CHECK(tot.solver_work > tot.contact_solve_iterations, "solver work %llu counts the %llu pivots and products",
+          (unsigned long long)tot.solver_work, (unsigned long long)tot.contact_solve_iterations);
     lc_world_destroy(w);
 }
 

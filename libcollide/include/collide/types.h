@@ -203,6 +203,9 @@ typedef struct lc_counters {
     uint64_t resting_contacts;        /* resting contact points in contact solves */
     uint64_t contact_solves;          /* complementarity solves for contact forces */
     uint64_t contact_solve_iterations;/* pivots, or products of the response matrix (large groups), in those solves */
+    uint64_t solver_work;             /* response-matrix entries visited by all complementarity solves (contact
+                                         forces, impulses, projection): m^2 per pivot of a dense solve of m rows,
+                                         m per product of a sparse one; what a step's solves cost */
     uint64_t impulse_solves;          /* complementarity solves for impulses */
     uint64_t position_projections;    /* end-of-step corrections of points found inside another body */
     uint64_t quiet_advances;          /* RK4 intervals of resting bodies taken with two force evaluations */

@@ -1,0 +1,91 @@
+"""libcollide repro: how much complementarity-solver work a step does per body, on the hardest scenes.
+
+A step is undone with LC_ERR_NUMERIC once its solves have visited more than LC_MAX_SOLVER_WORK_PER_BODY
+(1e9, libcollide/src/step.c) matrix entries per body of the world (lc_counters.solver_work: m^2 per
+pivot of a dense solve of m rows, 12 m per product of a sparse one). This prints, per scene, the step
+with the most solver work per body, its CPU time, and the cap's margin over it: the cap must sit well
+above every legitimate scene, and far below what a pathological step does (fuzz finding 32, four
+coincident 5e-12 m decagons at 1e6 m/s: 1.7e10 per body at the 500 000-evaluation cap, 110 s).
+
+    source scripts/env.sh && python bench/repro/solver_work_per_body.py [--quick]
+
+The heaviest scene is the box dropped onto a 78-box frictional pyramid (bench/repro/drop_into_pyramid.py):
+its first 45 steps, whose impact steps take up to ~10 s each (~2.5 min). The bench scenes run 600 steps
+of 1/60 s each, or 60 with --quick. Exit status 1 if any step was undone.
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+import collide
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+import scenes  # noqa: E402  (bench/scenes.py)
+
+CAP_PER_BODY = 1e9  # LC_MAX_SOLVER_WORK_PER_BODY in libcollide/src/step.c
+
+
+def world_of(sc: scenes.Scene) -> collide.World:
+    w = collide.World(gravity=(0.0, -sc.gravity), damping=0.0)
+    for b in sc.boxes:
+        w.add_box(b.w, b.h, position=(b.x, b.y), angle=b.angle, velocity=(b.vx, b.vy), angular_velocity=b.omega,
+                  mass=b.mass, elasticity=sc.e, friction=sc.mu, static=b.static)
+    return w
+
+
+def drop_into_pyramid(base: int = 12) -> collide.World:
+    """bench/repro/drop_into_pyramid.py's scene: a 5 kg box at 8 m/s onto a base-12 frictional pyramid."""
+    w = collide.World(gravity=(0.0, -10.0), damping=0.0)
+    for b in scenes.pyramid(base).boxes:
+        w.add_box(b.w, b.h, position=(b.x, b.y), mass=b.mass, static=b.static, elasticity=0.5 if b.static else 0.0,
+                  friction=0.6)
+    w.add_box(1.0, 1.0, position=(0.3, base + 2.0), velocity=(0.0, -8.0), angular_velocity=1.0, mass=5.0,
+              elasticity=0.5, friction=0.6)
+    return w
+
+
+def measure(name: str, w: collide.World, dt: float, steps: int) -> tuple[float, float, int]:
+    """Most solver work per body in one step, that step's CPU seconds, and the steps undone."""
+    most, cpu, undone = 0.0, 0.0, 0
+    for _ in range(steps):
+        t0 = time.process_time()
+        try:
+            w.step(dt)
+        except collide.CollideError:
+            undone += 1
+        t = time.process_time() - t0
+        per_body = w.counters(last=True)["solver_work"] / len(w)
+        if per_body > most:
+            most, cpu = per_body, t
+    margin = CAP_PER_BODY / most if most > 0 else float("inf")
+    print(f"{name:28s} {steps:5d} steps  most per body {most:9.3g} ({cpu:6.2f} s CPU)  cap / most {margin:9.3g}"
+          f"  undone {undone}", flush=True)
+    return most, cpu, undone
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--quick", action="store_true", help="fewer steps of each scene")
+    a = ap.parse_args()
+    n = 60 if a.quick else 600
+    cases = [("seed 20, g 9.8", scenes.seed(20, 9.8, 1)), ("settling", scenes.settling()),
+             ("stack 20", scenes.stack(20)), ("mass ratio 1000 stack", scenes.mass_ratio_stack()),
+             ("wedged", scenes.wedged()), ("smash", scenes.smash()), ("cradle", scenes.cradle(0.0)),
+             ("pyramid base 20", scenes.pyramid(20))]
+    worst = 0.0
+    undone = 0
+    for name, sc in cases:
+        most, _, u = measure(name, world_of(sc), 1 / 60, n)
+        worst, undone = max(worst, most), undone + u
+    most, _, u = measure("drop into pyramid base 12", drop_into_pyramid(), 1 / 60, 45)
+    worst, undone = max(worst, most), undone + u
+    print(f"most per body over all scenes {worst:.3g}: the cap (1e9) is {CAP_PER_BODY / worst:.3g}x that; "
+          f"steps undone {undone}")
+    return 1 if undone else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
