@@ -146,7 +146,7 @@ static int solve_with_friction(lc_world *w, const double *state, lc_touch *sub, 
         for (i = 0; i < m; ++i) bn[i] += b_n[i];
         lc_lcp_solve(m, Ann, bn, fn, NULL, opt, w->lcp, &res);
         w->last.contact_solve_iterations += (uint64_t)res.iterations;
-        w->last.solver_work += ((uint64_t)res.iterations + 2) * (uint64_t)m * (uint64_t)m;
+        w->last.solver_work += lc_lcp_work(m, &res);
         for (i = 0; i < m; ++i) if (!(fn[i] > 0.0) || !isfinite(fn[i])) fn[i] = 0.0;
         lc_response_rows(w, sub, m, 0, fn, 1, body, bt);
         for (i = 0; i < m; ++i) {
@@ -386,7 +386,7 @@ static int contact_forces(lc_world *w, const double *state, lc_touch *touches, i
         lc_lcp_solve(m, A, b, f, NULL, &opt, w->lcp, &res);
         w->last.contact_solves++;
         w->last.contact_solve_iterations += (uint64_t)res.iterations;
-        w->last.solver_work += ((uint64_t)res.iterations + 2) * (uint64_t)m * (uint64_t)m;
+        w->last.solver_work += lc_lcp_work(m, &res);
         w->last.resting_contacts += (uint64_t)m;
         if (res.residual > w->last.max_lcp_residual) w->last.max_lcp_residual = res.residual;
         for (j = 0; j < m; ++j) {

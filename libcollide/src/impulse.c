@@ -70,7 +70,7 @@ static int solve_block_friction(lc_world *w, double *state, lc_touch *t, int n, 
     }
     lc_lcp_solve_boxed(n2, A, b, NULL, NULL, coupled, mu, j, NULL, &o, w->lcp, &res);
     w->last.impulse_solves++;
-    w->last.solver_work += ((uint64_t)res.iterations + 2) * (uint64_t)n2 * (uint64_t)n2;
+    w->last.solver_work += lc_lcp_work(n2, &res);
     for (i = 0; i < n; ++i) {
         double jn = j[i] > 0.0 && isfinite(j[i]) ? j[i] : 0.0;
         double jt = isfinite(j[n + i]) ? j[n + i] : 0.0;
@@ -215,12 +215,13 @@ static int solve_block(lc_world *w, double *state, lc_touch *t, int n, int use_e
     if (with_friction) return solve_block_friction(w, state, t, n, b, restitute, &opt);
     if (n == 1) {
         j[0] = b[0] < 0.0 && A[0] > 0.0 ? -b[0] / A[0] : 0.0;
-        res.iterations = 1;
+        memset(&res, 0, sizeof res);
+        res.iterations = res.pivots = 1;
     } else {
         lc_lcp_solve(n, A, b, j, NULL, &opt, w->lcp, &res);
     }
     w->last.impulse_solves++;
-    w->last.solver_work += ((uint64_t)res.iterations + 2) * (uint64_t)n * (uint64_t)n;
+    w->last.solver_work += lc_lcp_work(n, &res);
     for (i = 0; i < n; ++i) {
         double ji = j[i] > 0.0 && isfinite(j[i]) ? j[i] : 0.0;
         if (ji <= 0.0) continue;

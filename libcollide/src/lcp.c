@@ -104,6 +104,12 @@ static int options_valid(const lc_lcp_options *o)
     return 1;
 }
 
+uint64_t lc_lcp_work(int n, const lc_lcp_result *res)
+{
+    uint64_t passes = 2u + (uint64_t)(res->pivots > 0 ? res->pivots : 0) + (uint64_t)(res->sweeps > 0 ? res->sweeps : 0);
+    return n > 0 ? passes * (uint64_t)n * (uint64_t)n : 0u;
+}
+
 static void fill_fail(int n, double *f, double *a_out, lc_lcp_result *res)
 {
     if (n > 0) {

@@ -37,6 +37,8 @@
 #ifndef LIBCOLLIDE_LCP_H
 #define LIBCOLLIDE_LCP_H
 
+#include <stdint.h>
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -77,6 +79,10 @@ typedef struct lc_lcp_result {
     int sweeps;      /* PGS sweeps done (0 if not run) */
     int fallback;    /* 1 if the exact method ran but the iterative one was then used */
 } lc_lcp_result;
+
+/* Matrix entries a solve of n rows visited, the unit of lc_counters.solver_work: n^2 for setting up
+ * and for the answer, and n^2 per pivot and per sweep, the sweeps of a fallback after the pivots too. */
+uint64_t lc_lcp_work(int n, const lc_lcp_result *res);
 
 /* Solves a = A f + b, 0 <= f _|_ a >= 0. f and a_out (may be NULL) have n entries.
  * opt may be NULL (defaults); ws may be NULL (a temporary workspace is used); res may be NULL.

@@ -24,7 +24,7 @@
  * (20 blocks), so evaluations alone let such a step run 110 s to their cap (fuzz finding 32).
  * Measured per body (bench/repro/solver_work_per_body.py): the hardest legitimate step, a box dropped
  * onto a 78-box frictional pyramid, does 1.1e8 (10.5 s of CPU), the bench scenes at most 3e5; that
- * input did 1.7e10 by the evaluation cap, and now stops at 1e9 after 4 s. */
+ * input did 1.7e10 by the evaluation cap, and now stops at 1e9 after 3 s. */
 #ifndef LC_MAX_SOLVER_WORK_PER_BODY
 #define LC_MAX_SOLVER_WORK_PER_BODY 1000000000
 #endif
@@ -424,7 +424,7 @@ static int project_once(lc_world *w, double *deepest, int *found)
     opt.max_iterations = w->def.lcp_max_iterations;
     opt.tolerance = w->def.lcp_tolerance;
     lc_lcp_solve(n, A, b, lam, NULL, &opt, w->lcp, &res);
-    w->last.solver_work += ((uint64_t)res.iterations + 2) * (uint64_t)n * (uint64_t)n;
+    w->last.solver_work += lc_lcp_work(n, &res);
     for (i = 0; i < n; ++i) {
         double l = lam[i] > 0.0 && isfinite(lam[i]) ? lam[i] : 0.0;
         if (l > 0.0) lc_touch_apply(w, &t[i], lc_scale(t[i].n, l), w->state, 6);

@@ -204,8 +204,9 @@ typedef struct lc_counters {
     uint64_t contact_solves;          /* complementarity solves for contact forces */
     uint64_t contact_solve_iterations;/* pivots, or products of the response matrix (large groups), in those solves */
     uint64_t solver_work;             /* response-matrix entries visited by all complementarity solves (contact
-                                         forces, impulses, projection): m^2 per pivot of a dense solve of m rows,
-                                         m per product of a sparse one; what a step's solves cost */
+                                         forces, impulses, projection): m^2 per pivot or sweep of a dense solve of
+                                         m rows, 12 m per product of a sparse one (6 entries a row, read twice);
+                                         what a step's solves cost, capped at 1e9 per body of the world */
     uint64_t impulse_solves;          /* complementarity solves for impulses */
     uint64_t position_projections;    /* end-of-step corrections of points found inside another body */
     uint64_t quiet_advances;          /* RK4 intervals of resting bodies taken with two force evaluations */
