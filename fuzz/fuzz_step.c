@@ -520,7 +520,10 @@ static void fz_step(fz_in *in, fz_ctx *c)
                          after);
                 fz_fail("one step took more than FZ_MAX_SERIAL_ITERS serial impulse iterations", msg);
             }
-            if ((double)last.solver_work > FZ_MAX_SOLVER_WORK_PER_BODY * (double)lc_world_body_count(c->w)) {
+            /* only a step that ran (kept or undone): a call refused before it runs (dt = inf) leaves the
+             * counters of an earlier step, which may have had more bodies than the world has now */
+            if ((s == LC_OK || s == LC_ERR_NUMERIC || s == LC_ERR_NO_MEMORY) &&
+                (double)last.solver_work > FZ_MAX_SOLVER_WORK_PER_BODY * (double)lc_world_body_count(c->w)) {
                 snprintf(msg, sizeof msg, "solver work %.3g with %d bodies in %s", (double)last.solver_work,
                          lc_world_body_count(c->w), after);
                 fz_fail("one step's solves took more than FZ_MAX_SOLVER_WORK_PER_BODY per body", msg);

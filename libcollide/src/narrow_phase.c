@@ -80,10 +80,12 @@ static int push_touch(const lc_world *w, const double *state, frame fa, frame fb
     lc_touch *t = (lc_touch *)buf->p;
     lc_vec2 p = to_world(fa, w->shape[a].v[vertex]);
     /* A point already recorded for this pair at (nearly) the same place is the same contact. "Nearly"
-     * is max_gap, but never a quarter of the smaller body: with a contact_distance of 0.5 m (the API
-     * allows up to 1 m) two corners of a 5 cm box were one contact, and the corner that sank into a
-     * wall was dropped for its neighbour above it; the step ended 8.7e-7 m in (fuzz finding 25). */
-    double merge = fmin(max_gap, 0.25 * fmin(w->shape[a].radius, w->shape[b].radius));
+     * is max_gap, but never a quarter of either body's shortest edge, so two corners of one body are
+     * never one contact: with a contact_distance of 0.5 m (the API allows up to 1 m) the two corners
+     * of a 5 cm box's end were one, and the corner that sank into a wall was dropped for its
+     * neighbour above it (fuzz finding 25: 8.7e-7 m in; a quarter of the smaller body's radius was
+     * not enough for a 5 cm x 90 cm box, finding 34: 5 cm in). */
+    double merge = fmin(max_gap, 0.25 * fmin(w->shape[a].min_edge, w->shape[b].min_edge));
     int j;
     for (j = first_of_pair; j < count; ++j) {
         lc_vec2 d = lc_sub(t[j].p, p);

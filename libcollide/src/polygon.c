@@ -88,6 +88,7 @@ lc_status lc_shape_build(lc_shape *out, const lc_vec2 *v, int count, char *why, 
     out->center_offset = lc_v(cx, cy);
     out->area = area2 / 2.0;
     for (i = 0; i < count; ++i) out->v[i] = lc_v(p[i].x - cx, p[i].y - cy);
+    out->min_edge = HUGE_VAL;
     for (i = 0; i < count; ++i) {
         lc_vec2 a = out->v[i], b = out->v[(i + 1) % count];
         lc_vec2 e = lc_sub(b, a);
@@ -97,6 +98,7 @@ lc_status lc_shape_build(lc_shape *out, const lc_vec2 *v, int count, char *why, 
         /* second moment of the triangle (0, a, b) about the centroid-origin, per unit area */
         j += c * (lc_dot(a, a) + lc_dot(a, b) + lc_dot(b, b));
         out->radius = fmax(out->radius, sqrt(lc_dot(a, a)));
+        out->min_edge = fmin(out->min_edge, len);
     }
     out->unit_inertia = (j / 12.0) / out->area;
     (void)sign;

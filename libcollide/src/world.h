@@ -25,6 +25,7 @@ typedef struct lc_shape {
     lc_vec2 n[LC_MAX_POLYGON_VERTICES];   /* outward unit normal of edge v[i] -> v[i+1] */
     lc_vec2 center_offset;                /* local-frame origin -> centre of mass, body frame */
     double radius;                        /* max |v[i]| */
+    double min_edge;                      /* length of the shortest edge */
     double area;
     double unit_inertia;                  /* moment about the centre of mass per unit mass, m^2 */
 } lc_shape;
