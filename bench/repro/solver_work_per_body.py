@@ -23,17 +23,15 @@ from pathlib import Path
 import collide
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+import engines  # noqa: E402  (bench/engines/)
 import scenes  # noqa: E402  (bench/scenes.py)
 
 CAP_PER_BODY = 1e9  # LC_MAX_SOLVER_WORK_PER_BODY in libcollide/src/step.c
 
 
 def world_of(sc: scenes.Scene) -> collide.World:
-    w = collide.World(gravity=(0.0, -sc.gravity), damping=0.0)
-    for b in sc.boxes:
-        w.add_box(b.w, b.h, position=(b.x, b.y), angle=b.angle, velocity=(b.vx, b.vy), angular_velocity=b.omega,
-                  mass=b.mass, elasticity=sc.e, friction=sc.mu, static=b.static)
-    return w
+    """The scene as bench/run builds it for libcollide (bench/engines/libcollide.py)."""
+    return engines.make("libcollide", sc).world
 
 
 def drop_into_pyramid(base: int = 12) -> collide.World:
