@@ -24,6 +24,8 @@ What happens (session 6, docs/physics.md):
 The script stops after --cpu seconds of CPU or --steps steps, whichever comes first; a step in
 progress is not interrupted.
 """
+from __future__ import annotations
+
 import argparse
 import sys
 import time
@@ -34,32 +36,46 @@ import collide
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 import scenes  # noqa: E402  (bench/scenes.py)
 
-ap = argparse.ArgumentParser()
-ap.add_argument("--base", type=int, default=12)
-ap.add_argument("--steps", type=int, default=12)
-ap.add_argument("--cpu", type=float, default=600.0)
-a = ap.parse_args()
-w = collide.World(gravity=(0.0, -10.0), damping=0.0)
-for b in scenes.pyramid(a.base).boxes:   # bench/run's layout, the ground last
-    w.add_box(b.w, b.h, position=(b.x, b.y), mass=b.mass, static=b.static, elasticity=0.5 if b.static else 0.0,
-              friction=0.6)
-w.add_box(1.0, 1.0, position=(0.3, a.base + 2.0), velocity=(0.0, -8.0), angular_velocity=1.0, mass=5.0,
-          elasticity=0.5, friction=0.6)
-total = 0.0
-for k in range(a.steps):
-    t0 = time.process_time()
-    try:
-        w.step(1 / 60)
-        status = "ok"
-    except collide.CollideError as e:
-        status = f"undone: {e}"
-    dt = time.process_time() - t0
-    total += dt
-    c = w.counters(last=True)
-    print(f"step {k + 1}: {dt:.2f} s CPU, {status}; collisions {c['collisions']}, TOI searches {c['toi_searches']}, "
-          f"force evaluations {c['force_evaluations']}, contact solves {c['contact_solves']}, "
-          f"products {c['contact_solve_iterations']}, residual {c['max_lcp_residual']:.3g} m/s^2, "
-          f"serial passes {c['serial_iterations']}, inelastic fallbacks {c['inelastic_fallbacks']}", flush=True)
-    if total > a.cpu:
-        print(f"stopping after {total:.0f} s of CPU")
-        break
+
+def world(base: int = 12) -> collide.World:
+    """The scene: a 5 kg box at 8 m/s onto a frictional pyramid of the given base, laid out as bench/run does."""
+    w = collide.World(gravity=(0.0, -10.0), damping=0.0)
+    for b in scenes.pyramid(base).boxes:   # the ground last
+        w.add_box(b.w, b.h, position=(b.x, b.y), mass=b.mass, static=b.static,
+                  elasticity=0.5 if b.static else 0.0, friction=0.6)
+    w.add_box(1.0, 1.0, position=(0.3, base + 2.0), velocity=(0.0, -8.0), angular_velocity=1.0, mass=5.0,
+              elasticity=0.5, friction=0.6)
+    return w
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--base", type=int, default=12, help="boxes in the pyramid's bottom row")
+    ap.add_argument("--steps", type=int, default=12, help="steps of 1/60 s at most")
+    ap.add_argument("--cpu", type=float, default=600.0, help="CPU seconds at most (a step is not interrupted)")
+    a = ap.parse_args()
+    w = world(a.base)
+    total = 0.0
+    for k in range(a.steps):
+        t0 = time.process_time()
+        try:
+            w.step(1 / 60)
+            status = "ok"
+        except collide.CollideError as e:
+            status = f"undone: {e}"
+        dt = time.process_time() - t0
+        total += dt
+        c = w.counters(last=True)
+        print(f"step {k + 1}: {dt:.2f} s CPU, {status}; collisions {c['collisions']}, "
+              f"TOI searches {c['toi_searches']}, force evaluations {c['force_evaluations']}, "
+              f"contact solves {c['contact_solves']}, products {c['contact_solve_iterations']}, "
+              f"residual {c['max_lcp_residual']:.3g} m/s^2, serial passes {c['serial_iterations']}, "
+              f"inelastic fallbacks {c['inelastic_fallbacks']}", flush=True)
+        if total > a.cpu:
+            print(f"stopping after {total:.0f} s of CPU")
+            break
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

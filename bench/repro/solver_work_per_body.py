@@ -23,6 +23,8 @@ from pathlib import Path
 import collide
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import drop_into_pyramid  # noqa: E402  (bench/repro/drop_into_pyramid.py, beside this script)
 import engines  # noqa: E402  (bench/engines/)
 import scenes  # noqa: E402  (bench/scenes.py)
 
@@ -32,17 +34,6 @@ CAP_PER_BODY = 1e9  # LC_MAX_SOLVER_WORK_PER_BODY in libcollide/src/step.c
 def world_of(sc: scenes.Scene) -> collide.World:
     """The scene as bench/run builds it for libcollide (bench/engines/libcollide.py)."""
     return engines.make("libcollide", sc).world
-
-
-def drop_into_pyramid(base: int = 12) -> collide.World:
-    """bench/repro/drop_into_pyramid.py's scene: a 5 kg box at 8 m/s onto a base-12 frictional pyramid."""
-    w = collide.World(gravity=(0.0, -10.0), damping=0.0)
-    for b in scenes.pyramid(base).boxes:
-        w.add_box(b.w, b.h, position=(b.x, b.y), mass=b.mass, static=b.static, elasticity=0.5 if b.static else 0.0,
-                  friction=0.6)
-    w.add_box(1.0, 1.0, position=(0.3, base + 2.0), velocity=(0.0, -8.0), angular_velocity=1.0, mass=5.0,
-              elasticity=0.5, friction=0.6)
-    return w
 
 
 def measure(name: str, w: collide.World, dt: float, steps: int) -> tuple[float, float, int]:
@@ -78,7 +69,7 @@ def main() -> int:
     for name, sc in cases:
         most, _, u = measure(name, world_of(sc), 1 / 60, n)
         worst, undone = max(worst, most), undone + u
-    most, _, u = measure("drop into pyramid base 12", drop_into_pyramid(), 1 / 60, 45)
+    most, _, u = measure("drop into pyramid base 12", drop_into_pyramid.world(12), 1 / 60, 45)
     worst, undone = max(worst, most), undone + u
     print(f"most per body over all scenes {worst:.3g}: the cap (1e9) is {CAP_PER_BODY / worst:.3g}x that; "
           f"steps undone {undone}")
