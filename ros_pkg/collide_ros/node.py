@@ -55,6 +55,11 @@ APPLIED = "applied/"  # prefix of the command echo topics
 MAX_CONTACTS_PER_MESSAGE = 1000
 MAX_CMD_SPEED = 1000.0  # m/s or rad/s: larger cmd_vel components are rejected
 CATCH_UP_LIMIT = 0.1  # s (wall): a loop further behind than this drops the backlog (counted as late)
+# A step C undoes (LC_ERR_NUMERIC: e.g. a crossing missed within a trial interval and caught by the
+# energy balance) is deterministic: retried as it was, it fails again and the sim would stand still
+# until a reset. Halving the step changes the trial intervals, so it is retried as two halves, each
+# of which may halve again, down to time_step / 2**SPLIT_DEPTH; only then is it a failure.
+SPLIT_DEPTH = 6
 
 
 @dataclass
@@ -229,6 +234,7 @@ class SimNode(Node):
         self._pub_time_sum = 0.0
         self._window_steps = 0
         self.late_steps = 0
+        self.split_steps = 0    # steps C undid that went through in parts (_step_in_parts)
         self._schedule_dirty = True
         self._diag_wall = time.perf_counter()
         self._diag_sim = self.sim_time
@@ -831,16 +837,47 @@ class SimNode(Node):
             self._bodies[name].set_external((fx, fy), tau)
         self._ext_bodies = set(total)
 
+    def _step_in_parts(self, dt: float) -> None:
+        """world.step(dt) and its impacts kept; a step C undoes is taken as halves instead (recursively,
+        SPLIT_DEPTH levels). Raises C's error if a part of dt / 2**SPLIT_DEPTH fails; the parts
+        before it stay taken (their time too: the sim clock then leaves the time_step grid)."""
+        try:
+            self.world.step(dt)
+            self._collect_collisions()
+            return
+        except CollideError as exc:
+            why = str(exc)
+        t = self.sim_time
+        parts = self._halves(dt, 1)
+        self.split_steps += 1
+        self._warn("split", f"physics step at t={t:.6f} s was undone by C ({why}); "
+                   f"taken as {parts} parts instead")
+
+    def _halves(self, dt: float, depth: int) -> int:
+        """Two steps of dt / 2, each halved again if C undoes it; returns the number of parts taken."""
+        n = 0
+        for _ in range(2):
+            try:
+                self.world.step(dt / 2)
+                self._collect_collisions()  # each part's impacts: the world keeps only the last part's
+                n += 1
+            except CollideError:
+                if depth >= SPLIT_DEPTH:
+                    raise
+                n += self._halves(dt / 2, depth + 1)
+        return n
+
     def step_once(self) -> bool:
         """One physics step and whatever publishing is due; False if the step failed (and was undone)."""
         self._apply_forces()
         t0 = time.perf_counter()
         try:
-            self.world.step(float(self._p["time_step"]))
+            self._step_in_parts(float(self._p["time_step"]))
         except CollideError as exc:
             # C undid the step. Drop every command and every spring made over ROS, so that what a
             # peer sent cannot keep the world from stepping (the scene's own forces stay).
-            self._reject("step", f"physics step at t={self.sim_time:.6f} s failed ({exc}); all thrust, "
+            self._reject("step", f"physics step at t={self.sim_time:.6f} s failed, also in parts of time_step / "
+                         f"{2 ** SPLIT_DEPTH} ({exc}); all thrust, "
                          f"thruster and cmd_vel commands and springs ({', '.join(self._springs) or 'none'}) "
                          "dropped")
             self._thrust.clear()
@@ -854,7 +891,6 @@ class SimNode(Node):
             self._apply_forces()
             return False
         t1 = time.perf_counter()
-        self._collect_collisions()
         self.steps += 1
         self.total_steps += 1
         self._window_steps += 1
@@ -978,7 +1014,7 @@ class SimNode(Node):
             "dynamic_bodies": str(len(self._dyn_names)), "contacts": str(len(self.world.contacts)),
             "sim_time": f"{sim:.6f}", "paused": str(self._paused).lower(),
             "rejected_commands": str(self.rejected), "last_rejection": self.last_rejection,
-            "dropped_contacts": str(self.dropped_contacts),
+            "dropped_contacts": str(self.dropped_contacts), "split_steps": str(self.split_steps),
         }
         vals.update(self._count_values())
         st.values = [KeyValue(key=k, value=v) for k, v in vals.items()]

@@ -39,7 +39,7 @@ def test_short_soak(tmp_path: Path) -> None:
     assert res.outside == 0 and res.penetrating == 0, f"max |centre| {res.max_abs_centre}"
     assert res.stuck_windows == []
     # every command accepted (all values legal) and echoed
-    assert res.rejected_commands == 0
+    assert res.rejected_commands == 0, res.rejection_lines
     for topic, sent in res.commands_sent.items():
         assert res.published[topic] == sent, topic
     # every message published during the recording is in the bag

@@ -1,0 +1,119 @@
+"""What the node does when C undoes a step (LC_ERR_NUMERIC), in-process (no executor).
+
+C's verdict is deterministic: the same state, forces and dt fail again, so a node that only retried
+would stand still until a reset (a short soak in CI saw four seconds of that). The node takes such a
+step as halves instead (collide_ros.node.SPLIT_DEPTH levels), and only when a part of
+time_step / 2**SPLIT_DEPTH fails does it drop the commands and springs made over ROS. The failure
+is injected here by wrapping the world's step (a step C undoes in a scene of legal values is rare:
+none in ~1.5e8 steps of the soak's command mix in-process, docs/hardening.md "Soak"); what is
+checked is the node's reaction: time, parts, counts, commands and the warning.
+"""
+from __future__ import annotations
+
+from collections.abc import Iterator
+from typing import Any
+
+import pytest
+import rclpy
+from geometry_msgs.msg import Point, Vector3, Wrench, WrenchStamped
+from rclpy.parameter import Parameter
+
+from collide import CollideError
+from collide_ros import node as node_mod
+from collide_ros.node import SimNode
+from libcollide_msgs.msg import SpringCommand
+
+DT = 0.001
+NUMERIC = 10  # LC_ERR_NUMERIC
+
+
+class FailingSteps:
+    """Stands in for World.step: a step longer than ``longest`` raises what C raises for an undone
+    step (state untouched); shorter ones run the real step. Records every dt asked for."""
+
+    def __init__(self, real: Any, longest: float) -> None:
+        self.real, self.longest, self.calls = real, longest, []  # type: ignore[var-annotated]
+
+    def __call__(self, dt: float, steps: int = 1) -> None:
+        self.calls.append(dt)
+        if dt > self.longest:
+            raise CollideError(NUMERIC, "injected: contact forces gained energy; the step was undone")
+        self.real(dt, steps)
+
+
+@pytest.fixture()
+def sim() -> Iterator[SimNode]:
+    ctx = rclpy.Context()
+    rclpy.init(context=ctx)
+    node = SimNode(context=ctx, cli_args=["--ros-args", "-r", "__ns:=/step_failure_probe"],
+                   parameter_overrides=[Parameter("blocks", value=2), Parameter("gravity", value=9.8),
+                                        Parameter("time_step", value=DT), Parameter("command_timeout", value=0.0)])
+    try:
+        yield node
+    finally:
+        node.destroy_node()
+        rclpy.shutdown(context=ctx)
+
+
+def _thrust_and_spring(sim: SimNode) -> None:
+    sim._on_thrust("block1", WrenchStamped(wrench=Wrench(force=Vector3(x=2.0))))
+    sim._on_spring(SpringCommand(name="mouse", body="block2", body_point=Point(x=0.1, y=0.2),
+                                 target=Point(x=1.0, y=2.0), stiffness=5.0))
+    assert sim.rejected == 0 and "block1" in sim._thrust and "mouse" in sim._springs
+
+
+def test_an_undone_step_is_taken_in_halves(sim: SimNode) -> None:
+    _thrust_and_spring(sim)
+    for _ in range(3):
+        assert sim.step_once()
+    t0, steps0 = sim.sim_time, sim.steps
+    fake = FailingSteps(sim.world.step, longest=DT / 8)
+    sim.world.step = fake  # type: ignore[method-assign]
+    assert sim.step_once()
+    # the full step and the halves of 1/2 and 1/4 fail; the 1/8 parts go through: 8 of them,
+    # each taken after its parent failed (depth-first), in time order
+    assert fake.calls.count(DT / 8) == 8 and fake.calls[0] == DT
+    assert [c for c in fake.calls if c <= DT / 8] == [DT / 8] * 8
+    # a step's worth of time (eight additions of dt/8: exact to a few ulp of t), one step counted
+    assert sim.sim_time == pytest.approx(t0 + DT, rel=0, abs=1e-15)
+    assert sim.steps == steps0 + 1 and sim.split_steps == 1
+    # nothing was rejected or dropped: the commands and the spring act on the next steps too
+    assert sim.rejected == 0 and "block1" in sim._thrust and "mouse" in sim._springs
+    assert sim._warned.get("split") is not None
+    sim.world.step = fake.real  # type: ignore[method-assign]
+    assert sim.step_once() and sim.split_steps == 1
+
+
+def test_a_step_that_fails_in_every_part_drops_the_commands_and_keeps_time(sim: SimNode) -> None:
+    _thrust_and_spring(sim)
+    assert sim.step_once()
+    t0, steps0, state0 = sim.sim_time, sim.steps, sim.world.state.copy()
+    fake = FailingSteps(sim.world.step, longest=0.0)  # every step fails
+    sim.world.step = fake  # type: ignore[method-assign]
+    assert not sim.step_once()
+    # depth-first down to dt / 2**SPLIT_DEPTH, where the first part fails: 1 + SPLIT_DEPTH attempts
+    assert fake.calls == [DT / 2 ** k for k in range(node_mod.SPLIT_DEPTH + 1)]
+    assert sim.sim_time == t0 and sim.steps == steps0
+    assert (sim.world.state == state0).all()
+    assert sim.rejected == 1 and "also in parts of time_step / 64" in sim.last_rejection
+    assert "injected" in sim.last_rejection
+    assert not sim._thrust and not sim._springs and sim.world.spring_count == 0
+    sim.world.step = fake.real  # type: ignore[method-assign]
+    assert sim.step_once() and sim.sim_time > t0
+
+
+class Capture:
+    def __init__(self) -> None:
+        self.messages: list[Any] = []
+
+    def publish(self, msg: Any) -> None:
+        self.messages.append(msg)
+
+
+def test_split_steps_in_diagnostics(sim: SimNode) -> None:
+    sim.split_steps = 3
+    capture = Capture()
+    sim._pub_diag = capture  # type: ignore[assignment]
+    sim._publish_diagnostics()
+    values = {kv.key: kv.value for kv in capture.messages[0].status[0].values}
+    assert values["split_steps"] == "3"
