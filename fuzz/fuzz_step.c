@@ -494,10 +494,11 @@ static void fz_step(fz_in *in, fz_ctx *c)
             lc_counters last;
             lc_world_get_counters(c->w, &last, NULL);
             fprintf(stderr, "fuzz_step: -> %s: collisions %llu, toi searches %llu, toi iterations %llu, serial %llu, "
-                    "contact solves %llu, force evaluations %llu\n", lc_status_string(s),
+                    "contact solves %llu, force evaluations %llu, solver work %.4g%s%s\n", lc_status_string(s),
                     (unsigned long long)last.collisions, (unsigned long long)last.toi_searches,
                     (unsigned long long)last.toi_iterations, (unsigned long long)last.serial_iterations,
-                    (unsigned long long)last.contact_solves, (unsigned long long)last.force_evaluations);
+                    (unsigned long long)last.contact_solves, (unsigned long long)last.force_evaluations,
+                    (double)last.solver_work, s != LC_OK ? ": " : "", s != LC_OK ? lc_world_last_error(c->w) : "");
         }
         snprintf(after, sizeof after, "step %d (dt = %.17g, %s)", c->steps, dt, lc_status_string(s));
         if (s != LC_OK) {
