@@ -300,7 +300,10 @@ def run_soak(duration: float, out: Path, seed: int = 1, state_rate: float = 10.0
         while time.monotonic() < t_end:
             now = time.monotonic()
             if now >= next_cmd:
-                drv.one(may_release=now < next_reset - 1.0)
+                # No release within 2 s of a reset: the executor may take the reset before spring
+                # messages still queued. 2 s of spring commands (~16 at 40 Hz, 1 in 5 a spring)
+                # overflow the node's depth-10 queue, so a release that late would first show as lost.
+                drv.one(may_release=now < next_reset - 2.0)
                 next_cmd += 1.0 / command_hz
             if now >= next_param:
                 p = drv.params()
