@@ -235,6 +235,7 @@ class SimNode(Node):
         self._window_steps = 0
         self.late_steps = 0
         self.split_steps = 0    # steps C undid that went through in parts (_step_in_parts)
+        self.failing_since: float | None = None  # sim time of the first of the failed steps in a row
         self._schedule_dirty = True
         self._diag_wall = time.perf_counter()
         self._diag_sim = self.sim_time
@@ -621,6 +622,7 @@ class SimNode(Node):
 
     def reset(self) -> None:
         self._springs.clear()  # the springs go with the old world
+        self.failing_since = None
         self._thrust.clear()
         self._thrusters.clear()
         self._cmd_vel = None
@@ -889,7 +891,10 @@ class SimNode(Node):
                 entry.spring.remove()
             self._springs.clear()
             self._apply_forces()
+            if self.failing_since is None:
+                self.failing_since = self.sim_time
             return False
+        self.failing_since = None
         t1 = time.perf_counter()
         self.steps += 1
         self.total_steps += 1
@@ -1004,6 +1009,11 @@ class SimNode(Node):
         st.level = DiagnosticStatus.WARN if slow else DiagnosticStatus.OK
         st.message = ("paused" if self._paused else
                       f"real-time factor {self.last_rtf:.3f} (target {target:g})" + (" - falling behind" if slow else ""))
+        if self.failing_since is not None:
+            # the world state itself cannot be stepped (commands and springs are gone already):
+            # only a reset, a parameter change or a new command can get it going again
+            st.level = DiagnosticStatus.ERROR
+            st.message = f"physics steps failing since t={self.failing_since:.6f} s: {self.last_rejection}"
         vals = {
             "real_time_factor": f"{self.last_rtf:.4f}", "target_real_time_factor": f"{target:g}",
             "step_time_mean_ms": f"{1e3 * self._step_time_sum / n:.4f}",

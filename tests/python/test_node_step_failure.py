@@ -15,6 +15,7 @@ from typing import Any
 
 import pytest
 import rclpy
+from diagnostic_msgs.msg import DiagnosticStatus
 from geometry_msgs.msg import Point, Vector3, Wrench, WrenchStamped
 from rclpy.parameter import Parameter
 
@@ -98,8 +99,14 @@ def test_a_step_that_fails_in_every_part_drops_the_commands_and_keeps_time(sim: 
     assert sim.rejected == 1 and "also in parts of time_step / 64" in sim.last_rejection
     assert "injected" in sim.last_rejection
     assert not sim._thrust and not sim._springs and sim.world.spring_count == 0
+    # the state itself fails: the node stands still, and /diagnostics says so at ERROR level
+    assert not sim.step_once() and sim.sim_time == t0 and sim.rejected == 2
+    status = _diagnostics(sim)
+    assert status.level == DiagnosticStatus.ERROR and f"failing since t={t0:.6f} s" in status.message
     sim.world.step = fake.real  # type: ignore[method-assign]
     assert sim.step_once() and sim.sim_time > t0
+    # (WARN, not OK: in-process nothing keeps the real-time factor of 1)
+    assert sim.failing_since is None and _diagnostics(sim).level != DiagnosticStatus.ERROR
 
 
 class Capture:
@@ -110,10 +117,18 @@ class Capture:
         self.messages.append(msg)
 
 
+def _diagnostics(sim: SimNode) -> Any:
+    """The status the node would publish now."""
+    capture = Capture()
+    real, sim._pub_diag = sim._pub_diag, capture  # type: ignore[assignment]
+    try:
+        sim._publish_diagnostics()
+    finally:
+        sim._pub_diag = real
+    return capture.messages[0].status[0]
+
+
 def test_split_steps_in_diagnostics(sim: SimNode) -> None:
     sim.split_steps = 3
-    capture = Capture()
-    sim._pub_diag = capture  # type: ignore[assignment]
-    sim._publish_diagnostics()
-    values = {kv.key: kv.value for kv in capture.messages[0].status[0].values}
+    values = {kv.key: kv.value for kv in _diagnostics(sim).values}
     assert values["split_steps"] == "3"
