@@ -60,6 +60,12 @@ CATCH_UP_LIMIT = 0.1  # s (wall): a loop further behind than this drops the back
 # until a reset. Halving the step changes the trial intervals, so it is retried as two halves, each
 # of which may halve again, down to time_step / 2**SPLIT_DEPTH; only then is it a failure.
 SPLIT_DEPTH = 6
+# ... unless the undone step was already costly (C's work caps: 5e5 force evaluations, 5e4 serial
+# passes, 1e9 solver work per body): 2 + 2 + ... more attempts at that cost would stall the loop (and
+# the executor, which waits for the world lock) for many times as long. A step of the default scene
+# does 0-30 evaluations, a few serial passes and ~1e3 solver work.
+SPLIT_MAX_WORK = {"force_evaluations": 10_000, "serial_iterations": 5_000}
+SPLIT_MAX_SOLVER_WORK_PER_BODY = 1e7
 
 
 @dataclass
@@ -235,6 +241,7 @@ class SimNode(Node):
         self._window_steps = 0
         self.late_steps = 0
         self.split_steps = 0    # steps C undid that went through in parts (_step_in_parts)
+        self._split_tried = False  # whether the last step C undid was tried in parts
         self.failing_since: float | None = None  # sim time of the first of the failed steps in a row
         self._schedule_dirty = True
         self._diag_wall = time.perf_counter()
@@ -841,19 +848,30 @@ class SimNode(Node):
 
     def _step_in_parts(self, dt: float) -> None:
         """world.step(dt) and its impacts kept; a step C undoes is taken as halves instead (recursively,
-        SPLIT_DEPTH levels). Raises C's error if a part of dt / 2**SPLIT_DEPTH fails; the parts
-        before it stay taken (their time too: the sim clock then leaves the time_step grid)."""
+        SPLIT_DEPTH levels), unless its work counters say it was costly (SPLIT_MAX_WORK). Raises C's
+        error if a part of dt / 2**SPLIT_DEPTH or a costly part fails; the parts before it stay taken
+        (their time too: the sim clock then leaves the time_step grid)."""
+        self._split_tried = False
         try:
             self.world.step(dt)
             self._collect_collisions()
             return
         except CollideError as exc:
             why = str(exc)
+            if not self._worth_splitting():
+                raise
+        self._split_tried = True
         t = self.sim_time
         parts = self._halves(dt, 1)
         self.split_steps += 1
         self._warn("split", f"physics step at t={t:.6f} s was undone by C ({why}); "
                    f"taken as {parts} parts instead")
+
+    def _worth_splitting(self) -> bool:
+        """Whether the step C just undid was cheap enough to be tried again in parts (its counters)."""
+        c = self.world.counters(last=True)
+        return (all(c[k] <= v for k, v in SPLIT_MAX_WORK.items())
+                and c["solver_work"] <= SPLIT_MAX_SOLVER_WORK_PER_BODY * max(len(self.world), 1))
 
     def _halves(self, dt: float, depth: int) -> int:
         """Two steps of dt / 2, each halved again if C undoes it; returns the number of parts taken."""
@@ -864,7 +882,7 @@ class SimNode(Node):
                 self._collect_collisions()  # each part's impacts: the world keeps only the last part's
                 n += 1
             except CollideError:
-                if depth >= SPLIT_DEPTH:
+                if depth >= SPLIT_DEPTH or not self._worth_splitting():
                     raise
                 n += self._halves(dt / 2, depth + 1)
         return n
@@ -878,8 +896,9 @@ class SimNode(Node):
         except CollideError as exc:
             # C undid the step. Drop every command and every spring made over ROS, so that what a
             # peer sent cannot keep the world from stepping (the scene's own forces stay).
-            self._reject("step", f"physics step at t={self.sim_time:.6f} s failed, also in parts of time_step / "
-                         f"{2 ** SPLIT_DEPTH} ({exc}); all thrust, "
+            how = (f"also in parts of time_step / {2 ** SPLIT_DEPTH}" if self._split_tried
+                   else "not split (a costly step: C's work counters past the node's split limits)")
+            self._reject("step", f"physics step at t={self.sim_time:.6f} s failed, {how} ({exc}); all thrust, "
                          f"thruster and cmd_vel commands and springs ({', '.join(self._springs) or 'none'}) "
                          "dropped")
             self._thrust.clear()

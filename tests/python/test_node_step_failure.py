@@ -109,6 +109,29 @@ def test_a_step_that_fails_in_every_part_drops_the_commands_and_keeps_time(sim: 
     assert sim.failing_since is None and _diagnostics(sim).level != DiagnosticStatus.ERROR
 
 
+def test_a_costly_undone_step_is_not_split(sim: SimNode) -> None:
+    # a step undone at C's work caps took seconds; its parts would each cost as much, so the node
+    # goes straight to dropping the commands (the verdict comes from the step's counters, here forced)
+    _thrust_and_spring(sim)
+    assert sim.step_once()
+    t0 = sim.sim_time
+    fake = FailingSteps(sim.world.step, longest=0.0)
+    sim.world.step = fake  # type: ignore[method-assign]
+    sim._worth_splitting = lambda: False  # type: ignore[method-assign]
+    assert not sim.step_once()
+    assert fake.calls == [DT] and sim.sim_time == t0 and sim.split_steps == 0
+    assert sim.rejected == 1 and "not split" in sim.last_rejection and not sim._springs
+
+
+def test_a_normal_step_is_worth_splitting(sim: SimNode) -> None:
+    # the real verdict on the default scene's steps: far inside the limits
+    for _ in range(50):
+        assert sim.step_once()
+    c = sim.world.counters(last=True)
+    assert c["force_evaluations"] < node_mod.SPLIT_MAX_WORK["force_evaluations"] // 100
+    assert sim._worth_splitting()
+
+
 class Capture:
     def __init__(self) -> None:
         self.messages: list[Any] = []
