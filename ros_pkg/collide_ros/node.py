@@ -64,7 +64,7 @@ SPLIT_DEPTH = 6
 # passes, 1e9 solver work per body): 2 + 2 + ... more attempts at that cost would stall the loop (and
 # the executor, which waits for the world lock) for many times as long. The soak's command mix on
 # four blocks took at most 1 484 evaluations, 400 serial passes and 2.4e5 solver work in a step
-# (3 runs, 3e6 steps; the most in a bounce-heavy pile-up of all four).
+# (three seeds of lean replays of it, 3.8e6 steps; the largest in one of the three).
 SPLIT_MAX_WORK = {"force_evaluations": 10_000, "serial_iterations": 5_000}
 SPLIT_MAX_SOLVER_WORK_PER_BODY = 1e7
 
