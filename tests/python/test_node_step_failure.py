@@ -1,12 +1,12 @@
 """What the node does when C undoes a step (LC_ERR_NUMERIC), in-process (no executor).
 
 C's verdict is deterministic: the same state, forces and dt fail again, so a node that only retried
-would stand still until a reset (a short soak in CI saw four seconds of that). The node takes such a
+would stand still until a reset (what a short soak in CI most likely ran into). The node takes such a
 step as halves instead (collide_ros.node.SPLIT_DEPTH levels), and only when a part of
 time_step / 2**SPLIT_DEPTH fails does it drop the commands and springs made over ROS. The failure
 is injected by wrapping the world's step where the node's bookkeeping is checked (time, parts,
-counts, commands, the warning); the last tests use a real one, a block at ~1e5 m/s and 1e5 rad/s.
-(With the soak's legal values it is rare: none in ~1.8e8 steps of its command mix in-process,
+counts, commands, the warning); two tests use a real one, a block at ~1e5 m/s and 1e5 rad/s.
+(With the soak's legal values it is rare: none in 2.5e8 steps of its command mix, soak/step_search.py;
 docs/hardening.md "A failed soak in CI".)
 """
 from __future__ import annotations
