@@ -12,7 +12,8 @@ CI's 52 000 steps/s: a command every 1 300 steps, a parameter every 104 000, a r
 * ``--mode node``: soak.soak.Driver into an in-process SimNode's own command handlers and
   ``step_once`` (no executor), so the node's force servo, watchdog and step split are the real ones;
   counts the steps C undid (``split_steps``) and the steps that failed even in parts.
-* ``--mode engine``: the engine alone through the Python API, the node's forces (body-frame
+* ``--mode engine``: soak.soak.Driver into EngineClient, the engine alone through the Python
+  API with the node's handling of each command and the node's forces (body-frame
   thrust, thrusters, the cmd_vel servo on block1, springs, watchdog, parameters) recomputed every
   ``--chunk`` steps instead of every step (~4x faster); counts the steps C undid and whether their
   two halves go through.
@@ -115,14 +116,15 @@ def run_node(seed: int, steps: int) -> SeedResult:
     return res
 
 
-class EngineDriver:
-    """The node's command semantics on a bare World (collide_ros/node.py, _apply_forces)."""
+class EngineClient:
+    """The node's command semantics on a bare World (collide_ros/node.py, _on_* and _apply_forces):
+    the client that soak.soak.Driver publishes its random commands to, so both modes draw the
+    soak's own mix."""
 
     GAINS = {"cmd_vel_linear_gain": 5.0, "cmd_vel_max_accel": 20.0, "cmd_vel_angular_gain": 5.0,
              "cmd_vel_max_angular_accel": 40.0}
 
-    def __init__(self, rng: random.Random) -> None:
-        self.r = rng
+    def __init__(self) -> None:
         self.p: dict[str, float] = {"gravity": 0.0, "elasticity": 1.0, "damping": 0.0, "green_mass": 1.0,
                                     "command_timeout": 0.5, **self.GAINS}
         self.reset()
@@ -141,45 +143,36 @@ class EngineDriver:
         self.springs: dict[str, Any] = {}
         self.cmd_vel: tuple[float, float, float, float] | None = None
 
-    def command(self, may_release: bool) -> None:
-        r, now = self.r, self.w.time
-        kind = r.choice(("thrust", "thrust", "thrusters", "cmd_vel", "spring"))
-        body = f"block{r.randint(1, BLOCKS)}"
-        if kind == "thrust":
-            frame = r.choice(("", body, "world"))
-            self.thrust[body] = (r.uniform(-20, 20), r.uniform(-20, 20), r.uniform(-5, 5), frame == "world", now)
-        elif kind == "thrusters":
-            b = f"block{r.randint(1, 2)}"
-            self.w.body(b).set_thruster_mask(sum(1 << i for i in range(4) if r.random() < 0.5))
-            self.thrusters[b] = now
-        elif kind == "cmd_vel":
-            self.cmd_vel = (r.uniform(-4, 4), r.uniform(-4, 4), r.uniform(-3, 3), now)
-        else:
-            name = r.choice(("mouse", "s2"))
-            release = may_release and name in self.springs and r.random() < 0.2
-            point, target = (r.uniform(-0.4, 0.4), r.uniform(-1.4, 1.4)), (r.uniform(-5, 5), r.uniform(-5, 5))
-            k, d, rest = r.uniform(0.5, 20.0), r.uniform(0, 2), r.uniform(0, 2)
-            old = self.springs.pop(name, None)
-            if not release:
-                self.springs[name] = self.w.add_spring(body, point, None, target, k, d, rest)
+    def publish(self, topic: str, msg: Any) -> None:
+        now = self.w.time
+        if topic.endswith("/thrust"):
+            body, f, t = topic.split("/")[0], msg.wrench.force, msg.wrench.torque
+            self.thrust[body] = (f.x, f.y, t.z, msg.header.frame_id == "world", now)
+        elif topic == "thrusters":
+            self.w.body(msg.body).set_thruster_mask(sum(1 << i for i, on in enumerate(msg.firing) if on))
+            self.thrusters[msg.body] = now
+        elif topic == "cmd_vel":
+            self.cmd_vel = (msg.linear.x, msg.linear.y, msg.angular.z, now)
+        else:  # spring: the driver releases only springs it made, and the points never repeat
+            old = self.springs.pop(msg.name, None)
+            if not msg.release:
+                self.springs[msg.name] = self.w.add_spring(
+                    msg.body, (msg.body_point.x, msg.body_point.y), None, (msg.target.x, msg.target.y),
+                    msg.stiffness, msg.damping, msg.rest_length)
             if old is not None:
                 old.remove()
 
-    def parameter(self) -> None:
-        r = self.r
-        key, value = r.choice((("gravity", r.uniform(-20, 20)), ("elasticity", r.uniform(0.3, 1.0)),
-                               ("damping", r.uniform(0, 1.0)), ("green_mass", r.uniform(0.2, 5.0)),
-                               ("command_timeout", r.uniform(0.1, 2.0)), ("cmd_vel_linear_gain", r.uniform(1, 20)),
-                               ("cmd_vel_max_accel", r.uniform(5, 50))))
-        self.p[key] = value
-        if key == "gravity":
-            self.w.set_gravity((0.0, -value))
-        elif key == "elasticity":
-            self.w.set_elasticity(value)
-        elif key == "damping":
-            self.w.set_damping(value)
-        elif key == "green_mass":
-            self.w.body("block1").mass = value
+    def set_parameters(self, values: dict[str, float]) -> None:
+        for key, value in values.items():
+            self.p[key] = value
+            if key == "gravity":
+                self.w.set_gravity((0.0, -value))
+            elif key == "elasticity":
+                self.w.set_elasticity(value)
+            elif key == "damping":
+                self.w.set_damping(value)
+            elif key == "green_mass":
+                self.w.body("block1").mass = value
 
     def apply_forces(self) -> None:
         now, p, w = self.w.time, self.p, self.w
@@ -218,30 +211,33 @@ def run_engine(seed: int, steps: int, chunk: int) -> SeedResult:
     from collide import CollideError
 
     res = SeedResult(seed)
-    drv = EngineDriver(random.Random(seed))
+    eng = EngineClient()
+    drv = Driver(eng, random.Random(seed))
     for s in range(0, steps, chunk):
         # the events of the chunk's steps, at the chunk's start (chunk divides none of the periods exactly)
         if s % CMD_EVERY < chunk:
-            drv.command(may_release=s % RESET_EVERY < RESET_EVERY - RELEASE_MARGIN)
+            drv.one(may_release=s % RESET_EVERY < RESET_EVERY - RELEASE_MARGIN)
         if s and s % PARAM_EVERY < chunk:
-            drv.parameter()
+            eng.set_parameters(drv.params())
         if s and s % RESET_EVERY < chunk:
+            eng.reset()
             drv.reset()
-        drv.apply_forces()
+        eng.apply_forces()
+        w = eng.w
         for _ in range(chunk):
             try:
-                drv.w.step(DT)
+                w.step(DT)
             except CollideError as exc:
                 res.undone += 1
-                state_t = drv.w.time
+                state_t = w.time
                 try:
-                    drv.w.step(DT / 2)
-                    drv.w.step(DT / 2)
+                    w.step(DT / 2)
+                    w.step(DT / 2)
                     res.events.append(f"step {res.steps}: t={state_t:.6f} s undone ({exc}); its halves went through")
                 except CollideError as exc2:
                     res.failed += 1
                     res.events.append(f"step {res.steps}: t={state_t:.6f} s undone ({exc}); halves too ({exc2})")
-            _keep_max(res, drv.w.counters(last=True))
+            _keep_max(res, w.counters(last=True))
             res.steps += 1
         if res.failed > 100:  # a state that cannot be stepped: the rest of the seed would say the same
             res.events.append(f"step {res.steps}: stopped after {res.failed} failures")
