@@ -23,6 +23,7 @@ from rclpy.parameter import Parameter
 from collide import CollideError
 from collide_ros import node as node_mod
 from collide_ros.node import SimNode
+from collide_ros.testing import diag_values
 from libcollide_msgs.msg import SpringCommand
 
 DT = 0.001
@@ -103,12 +104,12 @@ def test_a_step_that_fails_in_every_part_drops_the_commands_and_keeps_time(sim: 
     assert not sim._thrust and not sim._springs and sim.world.spring_count == 0
     # the state itself fails: the node stands still, and /diagnostics says so at ERROR level
     assert not sim.step_once() and sim.sim_time == t0 and sim.rejected == 2
-    status = _diagnostics(sim)
+    status = _diagnostics(sim).status[0]
     assert status.level == DiagnosticStatus.ERROR and f"failing since t={t0:.6f} s" in status.message
     sim.world.step = fake.real  # type: ignore[method-assign]
     assert sim.step_once() and sim.sim_time > t0
     # (WARN, not OK: in-process nothing keeps the real-time factor of 1)
-    assert sim.failing_since is None and _diagnostics(sim).level != DiagnosticStatus.ERROR
+    assert sim.failing_since is None and _diagnostics(sim).status[0].level != DiagnosticStatus.ERROR
 
 
 def test_a_costly_undone_step_is_not_split(sim: SimNode) -> None:
@@ -174,17 +175,16 @@ class Capture:
 
 
 def _diagnostics(sim: SimNode) -> Any:
-    """The status the node would publish now."""
+    """The DiagnosticArray the node would publish now."""
     capture = Capture()
     real, sim._pub_diag = sim._pub_diag, capture  # type: ignore[assignment]
     try:
         sim._publish_diagnostics()
     finally:
         sim._pub_diag = real
-    return capture.messages[0].status[0]
+    return capture.messages[0]
 
 
 def test_split_steps_in_diagnostics(sim: SimNode) -> None:
     sim.split_steps = 3
-    values = {kv.key: kv.value for kv in _diagnostics(sim).values}
-    assert values["split_steps"] == "3"
+    assert (diag_values(_diagnostics(sim)) or {})["split_steps"] == "3"
