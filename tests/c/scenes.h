@@ -20,6 +20,9 @@
  *   sc_step_n(w, dt, n)                - n steps; stops and fails a CHECK on the first non-OK status
  *   sc_contacts(w, &cs)                - the last step's contacts and their count
  *   sc_world_vertices(w, id, out)      - world vertices, returns the count
+ *   sc_static_box_rotated(w, width, height, x, y, angle, e)        - add a static rectangle turned by angle
+ *   sc_potential(w, gx, gy)            - gravitational energy -sum m g.p of the dynamic bodies (J, zero at
+ *                                        the origin), computed here from the state view
  */
 #ifndef LC_TESTS_SCENES_H
 #define LC_TESTS_SCENES_H
@@ -294,6 +297,42 @@ static inline int sc_contacts(const lc_world *w, const lc_contact **out)
     *out = NULL;
     if (lc_world_get_contacts(w, out, &n) != LC_OK) return 0;
     return n;
+}
+
+/* A static width x height rectangle centred on (x, y) and turned by angle (rad, counter-clockwise):
+ * a ramp. */
+static inline lc_body_id sc_static_box_rotated(lc_world *w, double width, double height, double x, double y,
+                                               double angle, double e)
+{
+    lc_vec2 v[4];
+    lc_body_def bd = lc_default_body_def();
+    lc_status s = lc_make_rectangle(width, height, v);
+    CHECK(s == LC_OK, "lc_make_rectangle(%g, %g) -> %s", width, height, lc_status_string(s));
+    bd.type = LC_BODY_STATIC;
+    bd.vertices = v;
+    bd.vertex_count = 4;
+    bd.position.x = x;
+    bd.position.y = y;
+    bd.angle = angle;
+    bd.elasticity = e;
+    return sc_add(w, &bd, "rotated static box");
+}
+
+/* Gravitational energy (J) of the dynamic bodies in a uniform field (gx, gy), zero at the world origin:
+ * -sum m (gx x + gy y), from the state view (independent of the engine's energy code). With the
+ * default zero_energy_level 0 it equals lc_energy.gravitational. */
+static inline double sc_potential(const lc_world *w, double gx, double gy)
+{
+    lc_state_view v;
+    double u = 0.0;
+    int i;
+    if (lc_world_get_state(w, &v) != LC_OK) return NAN;
+    for (i = 0; i < v.count; i++) {
+        const double *s = v.state + 6 * i;
+        if (v.is_static[i]) continue;
+        u -= v.mass[i] * (gx * s[0] + gy * s[1]);
+    }
+    return u;
 }
 
 #endif /* LC_TESTS_SCENES_H */
