@@ -28,6 +28,8 @@ class Task:
     budget: float = 20.0              # s of CPU; a run that exceeds it stops early (flagged)
     label: str = ""                   # engine variant label for tables and plots
     key: str = ""                     # case key (scene + setting) for grouping
+    stream: bool = False              # send every sample to the parent as it is taken, so that a run
+                                      # killed inside a step still returns the states it reached
 
     def __post_init__(self) -> None:
         if not self.label:
@@ -47,14 +49,18 @@ def run_task(task: Task, progress: Any = None) -> dict[str, Any]:
     # chunks of at most 0.25 s simulated, so the CPU budget is checked often
     per = max(1, int(round((0.25 if task.sample_dt is None else task.sample_dt) / task.dt)))
     times, states = [0.0], [eng.states()]
+    if progress is not None and task.stream:
+        progress(0, 0.0, states[0])
     cpu, done, status = 0.0, 0, "ok"
     while done < total:
         n = min(per, total - done)
         cpu += eng.advance(task.dt, n)
         done += n
-        if progress is not None:
-            progress(done, cpu)
         s = eng.states()
+        if progress is not None and task.stream:
+            progress(done, cpu, s)
+        elif progress is not None:
+            progress(done, cpu)
         if task.sample_dt is None and len(states) > 1:
             times.pop()
             states.pop()   # start and end only
@@ -89,7 +95,7 @@ def _worker(conn: Any) -> None:
         if task is None:
             return
         try:
-            conn.send(run_task(task, lambda steps, cpu: conn.send(("progress", steps, cpu))))
+            conn.send(run_task(task, lambda *msg: conn.send(("progress",) + msg)))
         except Exception as exc:  # report, keep serving
             conn.send({"key": task.key, "engine": task.engine, "label": task.label, "scene": task.scene.name,
                        "dt": task.dt, "status": f"error: {exc!r}", "trace": traceback.format_exc()})
@@ -123,6 +129,8 @@ class Pool:
         conn.send(task)
         wall_limit = 2 * task.budget + 10    # s of wall time without progress
         steps, cpu = 0, 0.0
+        times: list[float] = []
+        states: list[np.ndarray] = []
         while conn.poll(wall_limit):
             try:
                 msg = conn.recv()
@@ -130,6 +138,9 @@ class Pool:
                 break
             if isinstance(msg, tuple) and msg and msg[0] == "progress":
                 steps, cpu = msg[1], msg[2]
+                if len(msg) > 3:   # a streamed sample (Task.stream)
+                    times.append(steps * task.dt)
+                    states.append(msg[3])
                 continue
             return msg
         code = p.exitcode
@@ -138,8 +149,11 @@ class Pool:
         where = f"after {steps} steps ({steps * task.dt:.3g} s simulated, {cpu:.3g} s CPU)"
         why = (f"hang: no progress for {wall_limit:.0f} s wall, {where}" if alive
                else f"crashed (exit code {code}) {where}")
-        return {"key": task.key, "engine": task.engine, "label": task.label, "scene": task.scene.name,
-                "dt": task.dt, "status": why, "steps_done": steps, "cpu_done": cpu}
+        out = {"key": task.key, "engine": task.engine, "label": task.label, "scene": task.scene.name,
+               "dt": task.dt, "status": why, "steps_done": steps, "cpu_done": cpu}
+        if states:   # streamed: the samples it reached (the CPU of the step it died in is unknown)
+            out.update(times=np.array(times), states=np.array(states), wall_limit=wall_limit)
+        return out
 
     def close(self) -> None:
         for engine, (p, conn) in list(self._workers.items()):

@@ -2,8 +2,11 @@
 error on the issue-4 scenes. Use bench/run (it installs bench/requirements.txt first).
 
     bench/run [--quick | --full] [--sections wp,ref,impacts,cradle,tunnel,stacks,hard,pyramid,scaling]
+    bench/run [--quick] --sections contact    # piles, pushing, friction (bench/contact.py)
 
-Writes docs/benchmarks.md, docs/img/bench_*.png and bench/results/latest.json."""
+Writes docs/benchmarks.md, docs/img/bench_*.png and bench/results/latest.json. The contact section is
+not in the default list; it writes docs/bench_contact.md, and docs/benchmarks.md only when other
+sections ran too (a run of it alone leaves that page as it is)."""
 from __future__ import annotations
 
 import argparse
@@ -20,6 +23,7 @@ import numpy as np
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 
+import contact  # noqa: E402
 import harness  # noqa: E402
 import metrics  # noqa: E402
 import report  # noqa: E402
@@ -339,16 +343,27 @@ class Bench:
             rows.append({**strip(r), **m, "n": n})
         self.out["scaling"] = rows
 
+    # ---- contact: piles, pushing, friction (bench/contact.py) ----------------------------------
+    def contact(self) -> None:
+        """Every contact scene for libcollide, Box2D v3 and Chipmunk, sampled every step. Its own
+        CPU budget per libcollide run (--budget, else 20 s quick / 60 s), so that the section ends in
+        minutes even when libcollide is over budget on every scene; the peers always finish."""
+        budget = self.args.budget or (contact.BUDGET_QUICK if self.quick else contact.BUDGET_DEFAULT)
+        self.out["contact"] = contact.run_section(self.pool, list(contact.SCENE_KEYS), contact.ENGINES,
+                                                  self.repeats, budget, log)
+
 
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     g = ap.add_mutually_exclusive_group()
     g.add_argument("--quick", action="store_true", help="smoke run of a few seconds (1 seed, 1 repeat, short scenes)")
     g.add_argument("--full", action="store_true", help="more repeats, larger scenes, longer budgets")
-    ap.add_argument("--sections", default="wp,ref,impacts,cradle,tunnel,stacks,hard,pyramid,scaling")
+    ap.add_argument("--sections", default="wp,ref,impacts,cradle,tunnel,stacks,hard,pyramid,scaling",
+                    help="comma list; also 'contact' (not run by default: docs/bench_contact.md)")
     ap.add_argument("--out", default=os.path.join(ROOT, "docs", "benchmarks.md"),
                     help="markdown file to write; the plots go to img/ next to it")
-    ap.add_argument("--budget", type=float, help="CPU seconds per run before it is stopped (default 15, quick 4, full 60)")
+    ap.add_argument("--budget", type=float, help="CPU seconds per run before it is stopped (default 15, quick 4, "
+                    "full 60; contact: libcollide runs only, default 60, quick 20)")
     ap.add_argument("--no-report", action="store_true", help="only write bench/results/latest.json")
     args = ap.parse_args()
     t0 = time.time()
@@ -373,8 +388,13 @@ def main() -> int:
         json.dump(b.out, f, indent=1, default=_json)
     log(f"wrote {path}")
     if not args.no_report:
-        report.write(b.out, args.out, os.path.join(os.path.dirname(os.path.abspath(args.out)), "img"))
-        log(f"wrote {args.out}")
+        docs = os.path.dirname(os.path.abspath(args.out))
+        if any(sec.strip() != "contact" for sec in args.sections.split(",")):
+            report.write(b.out, args.out, os.path.join(docs, "img"))
+            log(f"wrote {args.out}")
+        if "contact" in b.out:   # a page of its own: report.write rewrites the whole of args.out
+            report.write_contact(b.out, os.path.join(docs, "bench_contact.md"))
+            log(f"wrote {os.path.join(docs, 'bench_contact.md')}")
     log(f"done in {time.time() - t0:.0f} s")
     return 0
 

@@ -4,6 +4,7 @@ momentum, per-scene errors."""
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -139,3 +140,166 @@ def trajectory_error(states: np.ndarray, ref: np.ndarray, half_diagonal: float) 
     turn = np.abs(np.remainder(a[..., 2] - b[..., 2] + np.pi, 2 * np.pi) - np.pi)
     d = np.hypot(a[..., 0] - b[..., 0], a[..., 1] - b[..., 1]) + half_diagonal * turn
     return float(np.max(d))
+
+
+# ---- contact section (bench/contact.py) ----------------------------------------------------------
+@dataclass(frozen=True)
+class BoxGeometry:
+    """What the overlap test needs of a scene besides the states: half extents (m, 2) of every box
+    (dynamic ones first, in state order, then the static ones), the static boxes' centres and angles,
+    and the static mask (m,)."""
+    half: np.ndarray
+    static_centre: np.ndarray
+    static_angle: np.ndarray
+    static: np.ndarray
+
+    @classmethod
+    def of(cls, scene: Any) -> "BoxGeometry":
+        dyn = [b for b in scene.boxes if not b.static]
+        sta = [b for b in scene.boxes if b.static]
+        return cls(0.5 * np.array([[b.w, b.h] for b in dyn + sta]).reshape(-1, 2),
+                   np.array([[b.x, b.y] for b in sta]).reshape(-1, 2), np.array([b.angle for b in sta]),
+                   np.array([False] * len(dyn) + [True] * len(sta)))
+
+    def poses(self, state: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Centres (m, 2) and angles (m,) of every box at one sample (state: (n_dynamic, 6))."""
+        s = np.asarray(state)
+        return np.concatenate([s[:, :2], self.static_centre]), np.concatenate([s[:, 2], self.static_angle])
+
+
+def _expand(start: np.ndarray, stop: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """All (p, q) with start[p] <= q < stop[p]: the flattened runs, built without a Python loop."""
+    count = np.maximum(stop - start, 0)
+    first = np.repeat(np.arange(len(start)), count)
+    offset = np.arange(len(first)) - np.repeat(np.cumsum(count) - count, count)
+    return first, start[first] + offset
+
+
+def aabb_pairs(lo: np.ndarray, hi: np.ndarray, static: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Index pairs (i, j), each once, whose boxes [lo, hi] (m, 2) overlap or touch, static-static
+    pairs left out. The few static boxes (walls, ground: any size) are tested against every dynamic
+    one directly; dynamic pairs come from a uniform grid whose cell is the largest dynamic box
+    extent, so two boxes can only meet if their min corners lie in the same or adjacent cells:
+    each cell is matched with itself and 4 of its 8 neighbours (each pair once)."""
+    dyn, sta = np.flatnonzero(~static), np.flatnonzero(static)
+    hit = ((lo[sta, None, 0] <= hi[None, dyn, 0]) & (lo[None, dyn, 0] <= hi[sta, None, 0])
+           & (lo[sta, None, 1] <= hi[None, dyn, 1]) & (lo[None, dyn, 1] <= hi[sta, None, 1]))
+    si, di = np.nonzero(hit)
+    pa, pb = [sta[si]], [dyn[di]]
+    if len(dyn) > 1:
+        size = max(float(np.max(hi[dyn] - lo[dyn])), 1e-9)
+        # cells counted from 1 (room for the -1 neighbour); clipped so that a body flung far away
+        # cannot overflow the key: clipping merges far cells, which only adds candidate pairs
+        cell = np.clip(np.floor((lo[dyn] - lo[dyn].min(axis=0)) / size), 0, 2 ** 20).astype(np.int64) + 1
+        ny = int(cell[:, 1].max()) + 2
+        key = cell[:, 0] * ny + cell[:, 1]
+        order = np.argsort(key, kind="stable")
+        ks = key[order]
+        pos = np.arange(len(ks))
+        for dx, dy in ((0, 0), (1, -1), (1, 0), (1, 1), (0, 1)):
+            want = ks + dx * ny + dy
+            start = pos + 1 if (dx, dy) == (0, 0) else np.searchsorted(ks, want, side="left")
+            p, q = _expand(start, np.searchsorted(ks, want, side="right"))
+            a, b = dyn[order[p]], dyn[order[q]]
+            keep = ((lo[a, 0] <= hi[b, 0]) & (lo[b, 0] <= hi[a, 0]) & (lo[a, 1] <= hi[b, 1])
+                    & (lo[b, 1] <= hi[a, 1]))
+            pa.append(a[keep])
+            pb.append(b[keep])
+    return np.concatenate(pa), np.concatenate(pb)
+
+
+def sat_depth(ca: np.ndarray, aa: np.ndarray, ha: np.ndarray, cb: np.ndarray, ab: np.ndarray,
+              hb: np.ndarray) -> np.ndarray:
+    """Penetration depth (m) of pairs of oriented boxes (centres (k, 2), angles (k,), half extents
+    (k, 2)): the smallest overlap of their projections on the four face normals, which for two
+    rectangles is exactly the shortest translation that separates them (separating-axis theorem).
+    <= 0 where the boxes are apart or touch; the caller clips at 0."""
+    ua = np.stack([np.cos(aa), np.sin(aa)], -1)                   # a's local x axis; y is (-s, c)
+    ub = np.stack([np.cos(ab), np.sin(ab)], -1)
+    va = np.stack([-ua[:, 1], ua[:, 0]], -1)
+    vb = np.stack([-ub[:, 1], ub[:, 0]], -1)
+    d = cb - ca
+    depth = np.full(len(ca), np.inf)
+    for n in (ua, va, ub, vb):
+        ra = ha[:, 0] * np.abs(np.sum(ua * n, -1)) + ha[:, 1] * np.abs(np.sum(va * n, -1))
+        rb = hb[:, 0] * np.abs(np.sum(ub * n, -1)) + hb[:, 1] * np.abs(np.sum(vb * n, -1))
+        depth = np.minimum(depth, ra + rb - np.abs(np.sum(d * n, -1)))
+    return depth
+
+
+def overlap_at(geom: BoxGeometry, state: np.ndarray) -> tuple[float, int, int]:
+    """Largest penetration depth (m, >= 0) over all pairs of boxes at one sample, static boxes
+    included (static-static pairs skipped: walls() boxes share their corners), and the pair (box
+    indices in BoxGeometry order; -1, -1 when nothing overlaps)."""
+    centre, angle = geom.poses(state)
+    c, s = np.abs(np.cos(angle)), np.abs(np.sin(angle))
+    half = geom.half
+    ext = np.stack([c * half[:, 0] + s * half[:, 1], s * half[:, 0] + c * half[:, 1]], -1)
+    a, b = aabb_pairs(centre - ext, centre + ext, geom.static)
+    if len(a) == 0:
+        return 0.0, -1, -1
+    depth = sat_depth(centre[a], angle[a], half[a], centre[b], angle[b], half[b])
+    k = int(np.argmax(depth))
+    if depth[k] <= 0.0:
+        return 0.0, -1, -1
+    return float(depth[k]), int(a[k]), int(b[k])
+
+
+def max_overlap(scene: Any, states: np.ndarray) -> dict[str, Any]:
+    """Largest penetration depth (m) over all samples (k, n, 6) and pairs; `overlap_sample` is the
+    sample index (= step when sampled every step; 0 = the initial state; -1 if nothing ever
+    overlaps) and `overlap_pair` the two boxes (BoxGeometry order: dynamic indices, then static)."""
+    geom = BoxGeometry.of(scene)
+    best, at, pair = 0.0, -1, (-1, -1)
+    for k, st in enumerate(states):
+        d, i, j = overlap_at(geom, st)
+        if d > best:
+            best, at, pair = d, k, (i, j)
+    return {"max_overlap": best, "overlap_sample": at, "overlap_pair": list(pair)}
+
+
+def escaped_bodies(states: np.ndarray, inner: tuple[float, float, float, float]) -> dict[str, Any]:
+    """Bodies whose centre is outside the inner box (xmin, ymin, xmax, ymax) at any sample (count)
+    and the first such sample (-1 if none). Inclusive bounds: a centre on the boundary is inside."""
+    s = np.asarray(states)
+    xmin, ymin, xmax, ymax = inner
+    out = (s[..., 0] < xmin) | (s[..., 0] > xmax) | (s[..., 1] < ymin) | (s[..., 1] > ymax)   # (k, n)
+    per_sample = np.any(out, axis=1)
+    return {"escaped": int(np.sum(np.any(out, axis=0))),
+            "escape_sample": int(np.argmax(per_sample)) if per_sample.any() else -1}
+
+
+def energy_steps(scene: Any, states: np.ndarray) -> dict[str, Any]:
+    """For runs sampled every step: the largest single-step relative energy gain
+    max_k (E[k+1] - E[k]) / |E[k]| with E = metrics.energy, the step k+1 it ends at, and the total
+    relative change (E_end - E_0) / |E_0|. In a scene without driving forces a gain is energy the
+    solver made; float32 engines (Box2D) show rounding gains of ~1e-7 from their state alone."""
+    e = energy(scene, states)
+    if len(e) < 2 or e[0] == 0.0:
+        return {"max_step_gain": math.nan, "gain_step": -1, "e_change": math.nan}
+    with np.errstate(divide="ignore", invalid="ignore"):
+        gain = np.diff(e) / np.abs(e[:-1])
+    k = int(np.nanargmax(gain)) if np.any(np.isfinite(gain)) else -1
+    return {"max_step_gain": float(gain[k]) if k >= 0 else math.nan, "gain_step": k + 1,
+            "e_change": float((e[-1] - e[0]) / abs(e[0]))}
+
+
+def sink_creep(states: np.ndarray) -> dict[str, Any]:
+    """For scenes that start at rest with the top box last (pyramid, stack): sink of the top box
+    y_0 - y at the end (`sink_end`) and the largest over the samples (`sink_max`), and creep = the
+    largest |x - x_0| over all boxes and samples (m; positive sink = lower than at the start)."""
+    s = np.asarray(states)
+    top = s[:, -1, 1]
+    return {"sink_end": float(top[0] - top[-1]), "sink_max": float(np.max(top[0] - top)),
+            "creep": float(np.max(np.abs(s[:, :, 0] - s[0, :, 0])))}
+
+
+def contact_metrics(scene: Any, res: dict[str, Any], inner: tuple[float, float, float, float],
+                    at_rest: bool) -> dict[str, Any]:
+    """The contact section's quality measures of one run (states sampled every step): max_overlap,
+    escaped, energy_steps, and sink_creep where the scene starts at rest with its top box last."""
+    s = res["states"]
+    out = {**max_overlap(scene, s), **escaped_bodies(s, inner), **energy_steps(scene, s)}
+    if at_rest:
+        out.update(sink_creep(s))
+    return out

@@ -182,3 +182,50 @@ def smash(rows: int = 10, cols: int = 10, v: float = 20.0, e: float = 1.0, durat
     heavy = Box(2.0, 2.0, -3.0, 0.5 * (rows - 1) * 0.5, vx=v, mass=40.0)
     grid = [Box(0.4, 0.4, 0.5 * c, 0.5 * r, mass=0.16) for r in range(rows) for c in range(cols)]
     return Scene(f"smash_{rows}x{cols}", tuple([heavy] + grid), e=e, duration=duration)
+
+
+# ---- contact section (bench/contact.py): piles, pushing, friction --------------------------------
+MIXED_SPACING = 1.2    # m between grid cells: the largest box's diagonal (0.8 sqrt 2 = 1.13 m) fits in
+                       # a cell, so no two boxes start overlapping whatever their angles
+
+
+def mixed_boxes(n: int, seed: int = 1, duration: float = 5.0, mu: float = 0.5, e: float = 0.3,
+                g: float = 9.81) -> Scene:
+    """n boxes with width and height each uniform in [0.3, 0.8] m (default_rng(seed): widths, then
+    heights, then angles in [0, pi)), 2 kg/m^2 (mass = 2 x area), at rest on a grid of
+    MIXED_SPACING cells, bottom row first, in a walled box of cols = ceil(1.2 sqrt n) columns whose
+    inner top is 2 m above the grid. They fall and pile up on the floor. meta["inner"] is the walls'
+    inner box (xmin, ymin, xmax, ymax)."""
+    rng = np.random.default_rng(seed)
+    w = rng.uniform(0.3, 0.8, n)
+    h = rng.uniform(0.3, 0.8, n)
+    angle = rng.uniform(0.0, np.pi, n)
+    cols = int(np.ceil(np.sqrt(n) * 1.2))
+    rows = int(np.ceil(n / cols))
+    width, height = cols * MIXED_SPACING, rows * MIXED_SPACING + 2.0
+    bodies = [Box(float(w[k]), float(h[k]), (k % cols + 0.5) * MIXED_SPACING, (k // cols + 0.5) * MIXED_SPACING,
+                  angle=float(angle[k]), mass=float(2.0 * w[k] * h[k])) for k in range(n)]
+    return Scene(f"mixed{n}_s{seed}", tuple(bodies + walls(0.0, 0.0, width, height)), gravity=g, e=e, mu=mu,
+                 duration=duration, meta={"inner": (0.0, 0.0, width, height), "seed": seed})
+
+
+def push_row(n: int = 40, v: float = 6.0, duration: float = 5.0, mu: float = 0.5, e: float = 0.3,
+             g: float = 9.81, width: float = 40.0) -> Scene:
+    """A 20 kg 1 m x 1 m block sliding at v m/s on the floor into a row of n 0.5 m boxes (1 kg)
+    resting on it 0.05 m apart; the block's front face starts 1 m from the first box. The walled
+    box is `width` m wide (the row ends at ~24.5 m, so it has room to be pushed) and 5 m tall.
+    meta["inner"]: the walls' inner box."""
+    block = Box(1.0, 1.0, 1.0, 0.5, vx=v, mass=20.0)
+    first = 1.5 + 1.0 + 0.25                       # block front face + 1 m gap + half a box
+    row = [Box(0.5, 0.5, first + k * 0.55, 0.25, mass=1.0) for k in range(n)]
+    return Scene(f"push_row{n}", tuple([block] + row + walls(0.0, 0.0, width, 5.0)), gravity=g, e=e, mu=mu,
+                 duration=duration, meta={"inner": (0.0, 0.0, width, 5.0)})
+
+
+def drop_on_pyramid(base: int = 12, duration: float = 5.0) -> Scene:
+    """bench/repro/drop_into_pyramid.py as a one-material scene: pyramid(base) (unit boxes, 1 kg,
+    mu 0.6, e 0, g 10) and a 5 kg unit box 2 m above the top (centre at y = base + 2) at 8 m/s
+    down, turning at 1 rad/s. The repro gives the box and the ground e 0.5; here all is e 0."""
+    pile = pyramid(base, duration=duration)
+    drop = Box(1.0, 1.0, 0.3, base + 2.0, vy=-8.0, omega=1.0, mass=5.0)
+    return replace(pile, name=f"drop_on_pyramid{base}", boxes=pile.boxes + (drop,))
