@@ -71,6 +71,7 @@ static int add_pair(lc_buf *buf, int count, int a, int b)
 static int add_if_near(const lc_world *w, lc_buf *buf, int count, const box *x, const box *y)
 {
     if (w->is_static[x->row] && w->is_static[y->row]) return count;
+    if (w->excluded && (w->excluded[x->row] || w->excluded[y->row])) return count;
     if (!overlap(x, y)) return count;
     return add_pair(buf, count, x->row, y->row);
 }
@@ -191,14 +192,12 @@ static void bound_box(const lc_world *w, const double *s0, const double *s1, int
     out->row = i;
 }
 
-int lc_broad_phase(lc_world *w, const double *s0, const double *s1, double margin, lc_buf *buf)
+/* The candidate pairs of boxes[0..count) (indexed by row). */
+static int pairs_of(lc_world *w, box *boxes, lc_buf *buf)
 {
     int n = w->count, i, j, count = 0;
-    box *boxes = swept_boxes(w, s0, s1, margin);
-    int use_sweep;
-    if (boxes == NULL) return -1;
-    use_sweep = w->def.broadphase == LC_BROADPHASE_SORT_AND_SWEEP ||
-                (w->def.broadphase == LC_BROADPHASE_AUTO && n >= w->def.broadphase_threshold);
+    int use_sweep = w->def.broadphase == LC_BROADPHASE_SORT_AND_SWEEP ||
+                    (w->def.broadphase == LC_BROADPHASE_AUTO && n >= w->def.broadphase_threshold);
     if (!use_sweep) {
         w->last.brute_force_steps++;
         for (i = 0; i < n; ++i)
@@ -216,6 +215,38 @@ int lc_broad_phase(lc_world *w, const double *s0, const double *s1, double margi
     }
     w->last.broadphase_pairs += (uint64_t)count;
     return count;
+}
+
+int lc_broad_phase(lc_world *w, const double *s0, const double *s1, double margin, lc_buf *buf)
+{
+    box *boxes = swept_boxes(w, s0, s1, margin);
+    if (boxes == NULL) return -1;
+    return pairs_of(w, boxes, buf);
+}
+
+void lc_swept_box(lc_world *w, const double *s0, const double *s1, int row, double margin, double out[4])
+{
+    box b;
+    swept_box(w, s0, s1, row, margin, &b);
+    out[0] = b.x0;
+    out[1] = b.y0;
+    out[2] = b.x1;
+    out[3] = b.y1;
+}
+
+int lc_broad_phase_boxes(lc_world *w, const double *boxes4, lc_buf *buf)
+{
+    int n = w->count, i;
+    box *boxes = lc_buf_get(&w->b_aabb, (size_t)(n > 0 ? n : 1) * sizeof(box));
+    if (boxes == NULL) return -1;
+    for (i = 0; i < n; ++i) {
+        boxes[i].x0 = boxes4[4 * i];
+        boxes[i].y0 = boxes4[4 * i + 1];
+        boxes[i].x1 = boxes4[4 * i + 2];
+        boxes[i].y1 = boxes4[4 * i + 3];
+        boxes[i].row = i;
+    }
+    return pairs_of(w, boxes, buf);
 }
 
 int lc_broad_phase_of(lc_world *w, const double *s0, const double *s1, double margin, const uint8_t *marked,

@@ -15,11 +15,13 @@
 /* Approach speed (m/s) above which an impact at this touch bounces: restitution_threshold, not below
  * resting_speed. Perfectly elastic pairs (e >= 1) bounce down to resting_speed, so energy is kept
  * exactly where the scene asks for it. */
-static double bounce_speed(const lc_world *w, const lc_touch *t)
+double lc_bounce_speed(const lc_world *w, double elasticity)
 {
-    if (t->elasticity >= 1.0) return w->def.resting_speed;
+    if (elasticity >= 1.0) return w->def.resting_speed;
     return fmax(w->def.resting_speed, w->def.restitution_threshold);
 }
+
+static double bounce_speed(const lc_world *w, const lc_touch *t) { return lc_bounce_speed(w, t->elasticity); }
 
 static double normal_velocity(const double *state, const lc_touch *t)
 {

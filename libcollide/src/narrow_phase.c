@@ -134,17 +134,21 @@ static double max_separation(const lc_shape *sb, const lc_vec2 *local, int count
 }
 
 /* Vertices of body `inc` (local[]: in the frame of `ref`; fi, fr: the two frames) within max_gap of edge
- * `edge` of body `ref` (and over its extent). */
+ * `edge` of body `ref` and over its extent, grown by `extent` for the vertices within `extent` of the
+ * edge's line: a vertex farther out that lies beyond the edge's end passes the end rather than hitting
+ * the edge (a corner sliding over a seam between two slabs, 1e-7 m above the second slab's side). */
 static int face_touches(const lc_world *w, const double *state, int inc, int ref, frame fi, frame fr,
-                        const lc_vec2 *local, int edge, double max_gap, lc_buf *buf, int count, int first_of_pair)
+                        const lc_vec2 *local, int edge, double max_gap, double extent, lc_buf *buf, int count,
+                        int first_of_pair)
 {
     const lc_shape *si = &w->shape[inc], *sr = &w->shape[ref];
     int i;
     for (i = 0; i < si->count && count >= 0; ++i) {
-        double d = edge_distance(sr, edge, local[i]), len, u;
+        double d = edge_distance(sr, edge, local[i]), len, u, grow;
         if (!(d < max_gap)) continue;
         u = edge_param(sr, edge, local[i], &len);
-        if (u * len < -max_gap || (u - 1.0) * len > max_gap) continue;
+        grow = d < extent ? extent : 0.0;
+        if (u * len < -grow || (u - 1.0) * len > grow) continue;
         count = push_touch(w, state, fi, fr, buf, count, first_of_pair, inc, i, ref, edge, max_gap);
     }
     return count;
@@ -165,6 +169,12 @@ double lc_pair_separation(const lc_world *w, const double *state, int a, int b)
 
 int lc_collect_touches(const lc_world *w, const double *state, int a, int b, double max_gap,
                        lc_buf *buf, int count)
+{
+    return lc_collect_touches_within(w, state, a, b, max_gap, max_gap, buf, count);
+}
+
+int lc_collect_touches_within(const lc_world *w, const double *state, int a, int b, double max_gap, double extent,
+                              lc_buf *buf, int count)
 {
     int first = count, ka, kb, ref, inc, kref, kinc, k;
     double sep_a, sep_b, best = INFINITY;
@@ -205,12 +215,12 @@ int lc_collect_touches(const lc_world *w, const double *state, int a, int b, dou
         double d = lc_dot(n, lc_rot(finc.c, finc.s, w->shape[inc].n[k]));
         if (d < best) { best = d; kinc = k; }
     }
-    count = face_touches(w, state, inc, ref, finc, fref, inc == a ? a_in_b : b_in_a, kref, max_gap, buf, count,
-                         first);
+    count = face_touches(w, state, inc, ref, finc, fref, inc == a ? a_in_b : b_in_a, kref, max_gap, extent, buf,
+                         count, first);
     if (count < 0) return count;
     /* the reference body's corners under the incident face (offset boxes: one point each way) */
-    return face_touches(w, state, ref, inc, fref, finc, ref == a ? a_in_b : b_in_a, kinc, max_gap, buf, count,
-                        first);
+    return face_touches(w, state, ref, inc, fref, finc, ref == a ? a_in_b : b_in_a, kinc, max_gap, extent, buf,
+                        count, first);
 }
 
 static int crossings_one_way(const lc_world *w, int a, int b, frame fa0, frame fb0, frame fa1, frame fb1,

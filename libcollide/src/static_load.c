@@ -37,16 +37,27 @@ static int holder_of(const lc_touch *t, int held)
     return t->a == held ? t->b : t->a;
 }
 
-/* Scratch: per body the touches it rests on (CSR: first[count + 1], list), the count of bodies resting
- * on it still unprocessed, and the processing order. */
+/* The bodies the graph is over: every row (local NULL, n = w->count), or the rows that `local` maps to
+ * 0..n-1 (an island's; static rows map to -1), so the work follows the touches, not the world. */
+typedef struct nodes {
+    const int *local;
+    const int *rows;   /* node -> row, when local is set */
+    int n;
+} nodes;
+
+static int node_of(const nodes *nd, int row) { return nd->local ? nd->local[row] : row; }
+static int row_of_node(const nodes *nd, int k) { return nd->local ? nd->rows[k] : k; }
+
+/* Scratch: per body (node) the touches it rests on (CSR: first[n + 1], list), the count of bodies
+ * resting on it still unprocessed, and the processing order (nodes). */
 typedef struct support_graph {
     int *first, *list, *pending, *order;
     int n_order;
 } support_graph;
 
-static int build_graph(lc_world *w, const lc_touch *t, int m, lc_vec2 up, support_graph *g)
+static int build_graph(lc_world *w, const lc_touch *t, int m, lc_vec2 up, const nodes *nd, support_graph *g)
 {
-    int n = w->count, i, head = 0;
+    int n = nd->n, i, head = 0;
     int *mem = lc_buf_get(&w->b_load_graph, ((size_t)n * 3 + 1 + (size_t)m) * sizeof(int));
     if (mem == NULL) return -1;
     g->first = mem;
@@ -56,10 +67,11 @@ static int build_graph(lc_world *w, const lc_touch *t, int m, lc_vec2 up, suppor
     memset(mem, 0, ((size_t)n * 3 + 1) * sizeof(int));
     for (i = 0; i < m; ++i) {
         double c;
-        int held = held_body(w, &t[i], up, &c);
+        int held = held_body(w, &t[i], up, &c), h;
         if (held < 0) continue;
-        g->first[held + 1]++;
-        if (!w->is_static[holder_of(&t[i], held)]) g->pending[holder_of(&t[i], held)]++;
+        g->first[node_of(nd, held) + 1]++;
+        h = holder_of(&t[i], held);
+        if (!w->is_static[h]) g->pending[node_of(nd, h)]++;
     }
     for (i = 0; i < n; ++i) g->first[i + 1] += g->first[i];
     /* fill with order[] as the cursor, then reuse order[] for the topological order */
@@ -67,21 +79,21 @@ static int build_graph(lc_world *w, const lc_touch *t, int m, lc_vec2 up, suppor
     for (i = 0; i < m; ++i) {
         double c;
         int held = held_body(w, &t[i], up, &c);
-        if (held >= 0) g->list[g->order[held]++] = i;
+        if (held >= 0) g->list[g->order[node_of(nd, held)]++] = i;
     }
     /* Kahn: bodies nothing rests on first, then each holder once all it holds are done */
     g->n_order = 0;
     for (i = 0; i < n; ++i)
-        if (!w->is_static[i] && g->pending[i] == 0) g->order[g->n_order++] = i;
+        if (!w->is_static[row_of_node(nd, i)] && g->pending[i] == 0) g->order[g->n_order++] = i;
     while (head < g->n_order) {
         int b = g->order[head++], k;
         for (k = g->first[b]; k < g->first[b + 1]; ++k) {
-            int h = holder_of(&t[g->list[k]], b);
-            if (!w->is_static[h] && --g->pending[h] == 0) g->order[g->n_order++] = h;
+            int h = holder_of(&t[g->list[k]], row_of_node(nd, b));
+            if (!w->is_static[h] && --g->pending[node_of(nd, h)] == 0) g->order[g->n_order++] = node_of(nd, h);
         }
     }
     for (i = 0; i < n; ++i)   /* cycles: whatever is left, in row order */
-        if (!w->is_static[i] && g->pending[i] > 0) g->order[g->n_order++] = i;
+        if (!w->is_static[row_of_node(nd, i)] && g->pending[i] > 0) g->order[g->n_order++] = i;
     return 0;
 }
 
@@ -105,13 +117,13 @@ static lc_vec2 centre_of(const lc_touch *t, int b)
  * not guessed to turn); among such shares the most nearly equal one (least squares), negative shares
  * cut to zero. A touch gets its share's part along its normal (c * share: a body on a slope is
  * pressed by its weight's normal part) and passes the share on to its holder at the touch point. */
-static void spread_loads(const lc_world *w, const lc_touch *t, lc_vec2 up, const support_graph *g, double *load,
-                         double *moment, double *out)
+static void spread_loads(const lc_world *w, const lc_touch *t, lc_vec2 up, const nodes *nd, const support_graph *g,
+                         double *load, double *moment, double *out)
 {
     lc_vec2 across = lc_v(up.y, -up.x);
     int j, k;
     for (j = 0; j < g->n_order; ++j) {
-        int b = g->order[j], k0 = g->first[b], k1 = g->first[b + 1], nk = k1 - k0;
+        int b = g->order[j], k0 = g->first[b], k1 = g->first[b + 1], nk = k1 - k0, rb = row_of_node(nd, b);
         double mean = 0.0, spread = 0.0, lever, sum = 0.0;
         if (nk == 0 || !(load[b] > 0.0)) continue;
         for (k = k0; k < k1; ++k) mean += lc_dot(t[g->list[k]].p, across) / (double)nk;
@@ -131,43 +143,65 @@ static void spread_loads(const lc_world *w, const lc_touch *t, lc_vec2 up, const
         for (k = k0; k < k1; ++k) {
             const lc_touch *tk = &t[g->list[k]];
             double c, share = sum > 0.0 ? out[g->list[k]] * load[b] / sum : load[b] / (double)nk;
-            int h = holder_of(tk, b);
+            int h = holder_of(tk, rb);
             (void)held_body(w, tk, up, &c);
             out[g->list[k]] = c * share;
             if (!w->is_static[h]) {
-                load[h] += share;
-                moment[h] += share * lc_dot(tk->p, across);
+                load[node_of(nd, h)] += share;
+                moment[node_of(nd, h)] += share * lc_dot(tk->p, across);
             }
         }
     }
 }
 
 /* moment[b] = own load[b] times b's centre across up (0 for a body that rests on nothing: unused) */
-static void own_moments(const lc_touch *t, lc_vec2 up, const support_graph *g, const double *load, double *moment,
-                        int n)
+static void own_moments(const lc_touch *t, lc_vec2 up, const nodes *nd, const support_graph *g, const double *load,
+                        double *moment)
 {
     lc_vec2 across = lc_v(up.y, -up.x);
     int b;
-    for (b = 0; b < n; ++b)
-        moment[b] = g->first[b + 1] > g->first[b] ? load[b] * lc_dot(centre_of(&t[g->list[g->first[b]]], b), across)
-                                                 : 0.0;
+    for (b = 0; b < nd->n; ++b)
+        moment[b] = g->first[b + 1] > g->first[b]
+                        ? load[b] * lc_dot(centre_of(&t[g->list[g->first[b]]], row_of_node(nd, b)), across)
+                        : 0.0;
 }
 
-int lc_static_load_forces(lc_world *w, const lc_touch *t, int m, double *f)
+static int load_forces(lc_world *w, const lc_touch *t, int m, const nodes *nd, double *f)
 {
     double *load;
     lc_vec2 up;
     support_graph g;
     int i;
     if (!up_direction(w, &up)) return 0;
-    if (build_graph(w, t, m, up, &g) != 0) return -1;
-    load = lc_buf_get(&w->b_load, (size_t)w->count * 2 * sizeof(double));
+    if (build_graph(w, t, m, up, nd, &g) != 0) return -1;
+    load = lc_buf_get(&w->b_load, (size_t)(nd->n > 0 ? nd->n : 1) * 2 * sizeof(double));
     if (load == NULL) return -1;
-    for (i = 0; i < w->count; ++i)
-        load[i] = w->is_static[i] ? 0.0 : lc_dot(w->def.gravity, up) * -w->mass[i];
-    own_moments(t, up, &g, load, load + w->count, w->count);
-    spread_loads(w, t, up, &g, load, load + w->count, f);
+    for (i = 0; i < nd->n; ++i) {
+        int r = row_of_node(nd, i);
+        load[i] = w->is_static[r] ? 0.0 : lc_dot(w->def.gravity, up) * -w->mass[r];
+    }
+    own_moments(t, up, nd, &g, load, load + nd->n);
+    spread_loads(w, t, up, nd, &g, load, load + nd->n, f);
     return 0;
+}
+
+int lc_static_load_forces(lc_world *w, const lc_touch *t, int m, double *f)
+{
+    nodes nd;
+    nd.local = NULL;
+    nd.rows = NULL;
+    nd.n = w->count;
+    return load_forces(w, t, m, &nd, f);
+}
+
+int lc_static_load_forces_of(lc_world *w, const lc_touch *t, int m, const int *local, const int *rows, int n,
+                             double *f)
+{
+    nodes nd;
+    nd.local = local;
+    nd.rows = rows;
+    nd.n = n;
+    return load_forces(w, t, m, &nd, f);
 }
 
 int lc_static_load_lifts(lc_world *w, const lc_touch *t, int m, const double *deficit, double *lam)
@@ -175,9 +209,13 @@ int lc_static_load_lifts(lc_world *w, const lc_touch *t, int m, const double *de
     double *load;
     lc_vec2 up;
     support_graph g;
+    nodes nd;
     int i, j, k;
+    nd.local = NULL;
+    nd.rows = NULL;
+    nd.n = w->count;
     if (!up_direction(w, &up)) return 0;
-    if (build_graph(w, t, m, up, &g) != 0) return -1;
+    if (build_graph(w, t, m, up, &nd, &g) != 0) return -1;
     load = lc_buf_get(&w->b_load, (size_t)w->count * 2 * sizeof(double));
     if (load == NULL) return -1;
     /* bottom up (the reverse order): a body must rise as far as the highest of its holders plus what
@@ -197,7 +235,7 @@ int lc_static_load_lifts(lc_world *w, const lc_touch *t, int m, const double *de
         load[b] = rise;
     }
     for (i = 0; i < w->count; ++i) load[i] *= w->is_static[i] ? 0.0 : w->mass[i];
-    own_moments(t, up, &g, load, load + w->count, w->count);
-    spread_loads(w, t, up, &g, load, load + w->count, lam);
+    own_moments(t, up, &nd, &g, load, load + w->count);
+    spread_loads(w, t, up, &nd, &g, load, load + w->count, lam);
     return 0;
 }

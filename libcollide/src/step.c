@@ -4,6 +4,10 @@
 #include <stdlib.h>
 #include <string.h>
 #include "world.h"
+#include "islands.h"
+#include "contact_regime.h"
+#include "regime.h"
+#include "tunables.h"
 
 /* Most a body may turn (rad) within one collision-checked interval. */
 #define LC_MAX_TRIAL_ROTATION 0.25
@@ -78,7 +82,6 @@ static int gather_touches(lc_world *w, const double *state, lc_buf *buf)
     return gather_touches_of(w, state, NULL, NULL, 0, buf);
 }
 
-static int push_contact(lc_world *w, const lc_touch *t, lc_contact_kind kind);
 
 /* Keys of a vertex against a body, and of a touch (vertex and edge), for the hash tables below. */
 static uint32_t vertex_key(const lc_world *w, int a, int vertex, int b)
@@ -140,7 +143,7 @@ static int warm_start(lc_world *w, lc_touch *t, int n)
  * Returns the resting count, -1 (no memory) or -2 (a point has passed deep into another body: the
  * step must fail). */
 static int gather_resting(lc_world *w, double *state, int *impacts, const uint8_t *marked, const int *list,
-                          int nlist, int mid_step, int *started_deep)
+                          int nlist, int mid_step, int *started_deep, int *persisting)
 {
     int n, i, k = 0, urgent = 0;
     lc_touch *t;
@@ -174,7 +177,7 @@ static int gather_resting(lc_world *w, double *state, int *impacts, const uint8_
         for (i = 0; i < n; ++i) {
             if (x[i].value > 0.0) {
                 w->last.impulses++;
-                if (push_contact(w, &x[i], LC_CONTACT_COLLISION) != 0) return -1;
+                if (lc_push_contact(w, &x[i], LC_CONTACT_COLLISION) != 0) return -1;
             }
             lc_touch_update(w, state, &t[i]);
         }
@@ -200,6 +203,12 @@ static int gather_resting(lc_world *w, double *state, int *impacts, const uint8_
      * bench/run's 20-block settling scene at e = 0.8 went from 8.3 to 32.5 impacts and from 2.4 to
      * 15.5 ms per step, and an e = 0 six-block pile (tests/c/test_pile.c) from 277 impacts in 10 s
      * to 840 000 by 8.7 s. */
+    /* A touch between bodies that are not perfectly elastic that neither approaches nor separates
+     * faster than it could bounce will persist: the contact regime's (regime.h) */
+    *persisting = -1;
+    for (i = 0; i < n && *persisting < 0; ++i)
+        if (t[i].elasticity < 1.0 && fabs(t[i].vn) <= fmax(w->def.resting_speed, lc_bounce_speed(w, t[i].elasticity)))
+            *persisting = w->is_static[t[i].a] ? t[i].b : t[i].a;
     for (i = 0; i < n; ++i)
         if ((t[i].vn >= -w->def.resting_speed &&
              t[i].vn <= (t[i].elasticity >= 1.0 ? 1e-2 : 1.0) * w->def.resting_speed) ||
@@ -241,6 +250,7 @@ static int gather_impact(lc_world *w, const double *state, const lc_crossing *c,
             double dx, dy, r;
             int before = n;
             if (k == body || seen[k] == 2) continue;   /* a pair with a finished body was collected */
+            if (w->excluded && w->excluded[k]) continue;   /* another island's */
             dx = state[body * 6 + SX] - state[k * 6 + SX];
             dy = state[body * 6 + SY] - state[k * 6 + SY];
             r = w->shape[body].radius + w->shape[k].radius + w->def.contact_distance;
@@ -280,7 +290,7 @@ static int gather_impact(lc_world *w, const double *state, const lc_crossing *c,
     return n;
 }
 
-static int push_contact(lc_world *w, const lc_touch *t, lc_contact_kind kind)
+int lc_push_contact(lc_world *w, const lc_touch *t, lc_contact_kind kind)
 {
     lc_contact *c;
     if (w->contact_count == w->contact_cap) {
@@ -333,6 +343,19 @@ static void add_counters(lc_counters *total, const lc_counters *last)
     total->impulse_solves += last->impulse_solves;
     total->position_projections += last->position_projections;
     total->quiet_advances += last->quiet_advances;
+    total->islands += last->islands;
+    total->island_retries += last->island_retries;
+    total->contact_islands += last->contact_islands;
+    total->contact_points += last->contact_points;
+    total->contact_sweeps += last->contact_sweeps;
+    total->contact_exact_solves += last->contact_exact_solves;
+    total->contact_cuts += last->contact_cuts;
+    total->contact_precise_retries += last->contact_precise_retries;
+    total->energy_clamps += last->energy_clamps;
+    total->contact_unresolved += last->contact_unresolved;
+    if (last->max_unresolved_overlap > total->max_unresolved_overlap) total->max_unresolved_overlap = last->max_unresolved_overlap;
+    if (last->max_unresolved_energy > total->max_unresolved_energy) total->max_unresolved_energy = last->max_unresolved_energy;
+    if (last->max_contact_residual > total->max_contact_residual) total->max_contact_residual = last->max_contact_residual;
     if (last->max_lcp_residual > total->max_lcp_residual) total->max_lcp_residual = last->max_lcp_residual;
     total->time_step += last->time_step;
     total->time_detection += last->time_detection;
@@ -341,6 +364,7 @@ static void add_counters(lc_counters *total, const lc_counters *last)
     total->time_impulses += last->time_impulses;
     total->time_projection += last->time_projection;
     total->time_contact_forces += last->time_contact_forces;
+    total->time_contact_regime += last->time_contact_regime;
 }
 
 /* Post-stabilisation: when a point ends the step closer than half the contact gap (or inside another
@@ -803,7 +827,7 @@ static int step_energy_blew_up(const lc_world *w, const double *backup, double d
     int i, k;
     /* a step of integration alone (no impact, no contact force) is checked by its finite state; the
      * balance costs ~5 % of a 20-block step and is kept for the steps where contacts acted */
-    if (started_deep || (w->last.collisions == 0 && w->last.contact_solves == 0)) return 0;
+    if (started_deep || (w->last.collisions == 0 && w->last.contact_solves == 0 && w->last.contact_islands == 0)) return 0;
     for (i = 0; i < w->count; ++i) {
         const double *a = &backup[i * 6], *b = &w->state[i * 6];
         double f, tau, v, om;
@@ -835,42 +859,38 @@ static lc_status step_failed(lc_world *w, const double *backup, double time0, lc
     return lc_fail(w, s, "%s; the step was undone", what);
 }
 
-lc_status lc_world_step(lc_world *w, double dt)
+/* 1 if an earlier try of this step found the contact regime unable to keep the island apart. */
+static int forced_event(const lc_world *w, const lc_island *isl)
+{
+    int i;
+    for (i = 0; i < isl->nrows; ++i)
+        if (w->force_event[isl->rows[i]]) return 1;
+    return 0;
+}
+
+/* The event regime over the given dynamic rows from time t0 for dt (the rest of the step that began at
+ * time0): every other dynamic body is left out of its pairs (w->excluded). With `handover` non-NULL it
+ * stops at the first instant a touch between bodies that are not perfectly elastic rests, with every
+ * event row advanced to that instant: *handover is then that touch's island and *t_handover the time
+ * it took; otherwise *handover is -1 and the rows reach the end of the step. */
+static lc_status event_step(lc_world *w, double dt, double t0, double time0, double *backup, const int *event_rows,
+                            int nrows, int *marks_known, int *handover, double *t_handover)
 {
     size_t bytes;
-    double *backup, *s0, *s1, *scratch, remaining, time0;
-    int *rows, nrows = 0, i, events = 0, nstalled = 0, nrest = 0, passes = 0;
+    double *s0, *s1, *scratch, remaining;
+    int *rows, i, events = 0, nstalled = 0, nrest = 0, passes = 0, persisting = -1, last_impact_body = -1;
+    int dissipative_events = 0;
     int *drows, ndirty = 0, local_next = 0, body_springs = 0, started_deep = 0;
     uint8_t *dirty;
     double last_tmin = 0.0, trial_left = 0.0, ts;
     lc_crossing stalled[LC_MAX_STALLED];
-    if (w == NULL) return LC_ERR_NULL;
-    if (!isfinite(dt)) return lc_fail(w, LC_ERR_NOT_FINITE, "dt is not finite (%g)", dt);
-    if (!(dt > 0.0) || dt > 1.0) return lc_fail(w, LC_ERR_OUT_OF_RANGE, "dt = %g is outside (0, 1] s", dt);
-    memset(&w->last, 0, sizeof w->last);
-    w->step_t0 = lc_stage_begin(w);
-    w->last.steps = 1;
-    w->step_dt = dt;
-    w->contact_count = 0;
-    time0 = w->time;
     bytes = (size_t)(w->count > 0 ? w->count : 1) * 6 * sizeof(double);
-    backup = lc_buf_get(&w->b_backup, bytes);
     s0 = lc_buf_get(&w->b_state0, bytes);
     s1 = lc_buf_get(&w->b_state1, bytes);
     scratch = lc_buf_get(&w->b_step_scratch, bytes);
     rows = lc_buf_get(&w->b_rows, (size_t)(w->count > 0 ? w->count : 1) * sizeof(int));
-    if (!backup || !s0 || !s1 || !scratch || !rows) return lc_fail(w, LC_ERR_NO_MEMORY, "out of memory in step");
-    if (w->count == 0) {
-        /* nothing to move: time still passes */
-        w->time += dt;
-        lc_stage_end(w, &w->last.time_step, w->step_t0);
-        add_counters(&w->total, &w->last);
-        w->error[0] = '\0';
-        return LC_OK;
-    }
-    memcpy(backup, w->state, (size_t)w->count * 6 * sizeof(double));
-    for (i = 0; i < w->count; ++i)
-        if (!w->is_static[i]) rows[nrows++] = i;
+    if (!s0 || !s1 || !scratch || !rows) return lc_fail(w, LC_ERR_NO_MEMORY, "out of memory in step");
+    memcpy(rows, event_rows, (size_t)nrows * sizeof(int));
     dirty = lc_buf_get(&w->b_dirty, (size_t)w->count);
     drows = lc_buf_get(&w->b_drows, (size_t)w->count * sizeof(int));
     if (!dirty || !drows) return lc_fail(w, LC_ERR_NO_MEMORY, "out of memory in step");
@@ -893,15 +913,27 @@ lc_status lc_world_step(lc_world *w, double dt)
          * every other pair was apart (nothing rested) and moved without an impact */
         ts = lc_stage_begin(w);
         if (local_next && !body_springs)
-            nrest = gather_resting(w, w->state, &events, dirty, drows, ndirty, passes > 0, &started_deep);
+            nrest = gather_resting(w, w->state, &events, dirty, drows, ndirty, passes > 0, &started_deep, &persisting);
         else
-            nrest = gather_resting(w, w->state, &events, NULL, NULL, 0, passes > 0, &started_deep);
+            nrest = gather_resting(w, w->state, &events, NULL, NULL, 0, passes > 0, &started_deep, &persisting);
         lc_stage_end(w, &w->last.time_detection, ts);
         if (nrest == -2)
             return step_failed(w, backup, time0, LC_ERR_NUMERIC,
                                "a body passed deep into another within the step (speeds or spins beyond what dt can resolve)");
         if (nrest < 0) goto oom;
         rest = (lc_touch *)w->b_touch.p;
+        /* from here on that touch persists, which the contact regime advances (regime.h); so does a burst
+         * of impacts (inelastic collapse: a block bouncing ever lower, e^k, where no speed threshold
+         * stops it) */
+        if (handover != NULL && persisting < 0 && dissipative_events >= LC_HANDOVER_EVENTS) persisting = last_impact_body;
+        if (handover != NULL && persisting >= 0) {
+            lc_island isl = lc_islands_get(w->islands, lc_islands_of(w->islands, persisting));
+            if (!lc_regime_too_fast(w, &isl, remaining) && !forced_event(w, &isl)) {
+                *handover = lc_islands_of(w->islands, persisting);
+                *t_handover = dt - remaining;
+                return LC_OK;
+            }
+        }
         memcpy(s0, w->state, (size_t)w->count * 6 * sizeof(double));
         /* Vertex paths are tested as straight lines in the other body's frame; that holds while bodies
          * turn little, so a fast spinner is checked over shorter trial intervals. */
@@ -1035,7 +1067,7 @@ lc_status lc_world_step(lc_world *w, double dt)
             memcpy(w->state, s1, (size_t)w->count * 6 * sizeof(double));
             remaining -= trial;
             if (remaining < 1e-14 * dt) remaining = 0.0;
-            w->time = time0 + (dt - remaining);
+            w->time = t0 + (dt - remaining);
             continue;
         }
 
@@ -1067,7 +1099,7 @@ lc_status lc_world_step(lc_world *w, double dt)
         }
         lc_stage_end(w, &w->last.time_integration, ts);
         remaining -= tmin;
-        w->time = time0 + (dt - remaining);
+        w->time = t0 + (dt - remaining);
         if (remaining < 1e-14 * dt) remaining = 0.0;
 
         ts = lc_stage_begin(w);
@@ -1079,11 +1111,17 @@ lc_status lc_world_step(lc_world *w, double dt)
         if (hits < 0) goto oom;
         {
             lc_touch *t = (lc_touch *)w->b_impact.p;
+            int dissipative = 0;
             for (i = 0; i < nimp; ++i)
                 if (t[i].value > 0.0) {
                     w->last.impulses++;
-                    if (push_contact(w, &t[i], LC_CONTACT_COLLISION) != 0) goto oom;
+                    if (lc_push_contact(w, &t[i], LC_CONTACT_COLLISION) != 0) goto oom;
+                    if (t[i].elasticity < 1.0) {
+                        dissipative = 1;
+                        last_impact_body = w->is_static[t[i].a] ? t[i].b : t[i].a;
+                    }
                 }
+            dissipative_events += dissipative;
         }
         lc_stage_end(w, &w->last.time_impulses, ts);
         w->last.collisions++;
@@ -1109,7 +1147,8 @@ lc_status lc_world_step(lc_world *w, double dt)
             nstalled++;
         }
     }
-    if (remaining == 0.0) w->time = time0 + dt;
+    if (remaining == 0.0) w->time = t0 + dt;
+    if (handover != NULL) *handover = -1;
     if (step_energy_blew_up(w, backup, dt, started_deep))
         return step_failed(w, backup, time0, LC_ERR_NUMERIC,
                            "the step gained far more energy than its external forces and thrusters can give "
@@ -1131,15 +1170,231 @@ lc_status lc_world_step(lc_world *w, double dt)
         for (i = 0; i < nrest; ++i) {
             lc_touch t = rest[i];
             lc_touch_update(w, w->state, &t);
-            if (push_contact(w, &t, LC_CONTACT_RESTING) != 0) goto oom;
+            if (lc_push_contact(w, &t, LC_CONTACT_RESTING) != 0) goto oom;
         }
     }
+    /* what the event rows rest on at the end, for the next step's regime (the projection's last search
+     * was at the end state when it kept its touches) */
+    for (i = 0; i < nrows; ++i) w->rests_dissipative[rows[i]] = 0;
+    *marks_known = w->end_touch_count >= 0 || nrows == 0;
+    if (w->end_touch_count >= 0) lc_regime_mark(w, (const lc_touch *)w->b_end_touches.p, w->end_touch_count);
+    return LC_OK;
+oom:
+    return step_failed(w, backup, time0, LC_ERR_NO_MEMORY, "out of memory during the step");
+}
+
+/* The bodies that went where their island's build did not foresee: the boxes their actual paths swept
+ * (start and end poses, the bulge of their turn, contact_distance) overlap another body's where the
+ * build had no pair, so a contact between them could have been missed. Their swept boxes are added to
+ * `reach` for the next try. Returns how many pairs that was, or -1 without memory. */
+static int unforeseen_pairs(lc_world *w, const double *backup, double *reach)
+{
+    int n = w->count, i, np, found = 0, outside = 0;
+    double *boxes = lc_buf_get(&w->b_reach_boxes, (size_t)n * 4 * sizeof(double));
+    const double *built = lc_islands_boxes(w->islands);
+    const int *pairs;
+    if (boxes == NULL) return -1;
+    for (i = 0; i < n; ++i) {
+        double turn = fabs(w->state[i * 6 + SA] - backup[i * 6 + SA]);
+        double bulge = w->shape[i].radius * (turn < 3.0 ? turn * turn / 8.0 : 1.0);
+        const double *b = &boxes[4 * i], *p = &built[4 * i];
+        lc_swept_box(w, backup, w->state, i, w->def.contact_distance + bulge, &boxes[4 * i]);
+        if (b[0] < p[0] || b[1] < p[1] || b[2] > p[2] || b[3] > p[3]) outside = 1;
+    }
+    /* every path inside the box its island was built with: the build's pairs hold every meeting */
+    if (!outside) return 0;
+    np = lc_broad_phase_boxes(w, boxes, &w->b_pairs);
+    if (np < 0) return -1;
+    pairs = (const int *)w->b_pairs.p;
+    for (i = 0; i < np; ++i) {
+        int a = pairs[2 * i], b = pairs[2 * i + 1], q;
+        if (lc_islands_has_pair(w->islands, a, b)) continue;
+        found++;
+        for (q = 0; q < 2; ++q) {
+            int r = q ? b : a;
+            double *x = &reach[4 * r];
+            const double *y = &boxes[4 * r];
+            if (w->is_static[r]) continue;
+            if (x[0] > x[2]) {
+                memcpy(x, y, 4 * sizeof(double));
+            } else {
+                x[0] = fmin(x[0], y[0]);
+                x[1] = fmin(x[1], y[1]);
+                x[2] = fmax(x[2], y[2]);
+                x[3] = fmax(x[3], y[3]);
+            }
+        }
+    }
+    return found;
+}
+
+/* The contact advance of island isl over dt: LC_OK, or the step has failed (and is undone). *stuck is
+ * set to the island's index + 1 when its projection could not separate its bodies. */
+static lc_status contact_island(lc_world *w, const lc_island *isl, int index, double dt, double time0,
+                                double *backup, int *stuck)
+{
+    double ts = lc_stage_begin(w);
+    int r = lc_contact_advance(w, w->contact, isl, dt);
+    lc_stage_end(w, &w->last.time_contact_regime, ts);
+    if (r == -1) return step_failed(w, backup, time0, LC_ERR_NO_MEMORY, "out of memory during the step");
+    if (r == -2)
+        return step_failed(w, backup, time0, LC_ERR_NUMERIC,
+                           "the contact regime produced a non-finite state (forces too stiff for dt?)");
+    if (r == -3) *stuck = index + 1;
+    return LC_OK;
+}
+
+/* One try at the step: the islands of the current state (their swept boxes grown to `reach`), each
+ * advanced in its regime. LC_OK, or the step has failed (and is undone). A try stops early, with
+ * *stuck the island's index + 1, when a contact island ends overlapping. */
+static lc_status advance_islands(lc_world *w, double dt, double time0, double *backup, const double *reach,
+                                 int *marks_known, int *stuck)
+{
+    int *event_rows = lc_buf_get(&w->b_event_rows, (size_t)w->count * sizeof(int));
+    uint8_t *excluded = lc_buf_get(&w->b_excluded, (size_t)w->count);
+    int n_event = 0, k, i, any_contact = 0;
+    double t0 = time0;
+    lc_status st;
+    if (!event_rows || !excluded || lc_islands_build(w, w->islands, dt, NULL, reach) != 0)
+        return step_failed(w, backup, time0, LC_ERR_NO_MEMORY, "out of memory during the step");
+    memset(excluded, 0, (size_t)w->count);
+    for (k = 0; k < lc_islands_count(w->islands); ++k) {
+        lc_island isl = lc_islands_get(w->islands, k);
+        w->last.islands++;
+        if (lc_regime_of(w, &isl, dt) != LC_REGIME_CONTACT || forced_event(w, &isl)) continue;
+        st = contact_island(w, &isl, k, dt, time0, backup, stuck);
+        if (st != LC_OK || *stuck) return st;
+        for (i = 0; i < isl.nrows; ++i) excluded[isl.rows[i]] = 1;
+        any_contact = 1;
+    }
+    /* the event islands' rows together, in row order; an island whose touch comes to rest is handed to
+     * the contact regime at that instant, and the others go on from there */
+    for (;;) {
+        int handover = -1;
+        double t_handover = 0.0;
+        n_event = 0;
+        for (i = 0; i < w->count; ++i)
+            if (!w->is_static[i] && !excluded[i]) event_rows[n_event++] = i;
+        w->time = t0;
+        if (any_contact) {
+            /* the event regime's pairs leave out the contact islands' bodies, and its kept end touches
+             * would not describe them */
+            w->excluded = excluded;
+            w->end_touch_count = -1;
+        }
+        if (n_event == 0 && any_contact) {
+            /* every island was the contact regime's: no event pass (its broadphases would find nothing) */
+            w->excluded = NULL;
+            *marks_known = 1;
+            w->time = time0 + dt;
+            if (step_energy_blew_up(w, backup, dt, 0))
+                return step_failed(w, backup, time0, LC_ERR_NUMERIC,
+                                   "the step gained far more energy than its external forces and thrusters can give "
+                                   "(speeds or spins beyond what dt can resolve)");
+            return LC_OK;
+        }
+        st = event_step(w, time0 + dt - t0, t0, time0, backup, event_rows, n_event, marks_known,
+                        w->def.regime == LC_REGIME_AUTO ? &handover : NULL, &t_handover);
+        w->excluded = NULL;
+        if (st != LC_OK || handover < 0) break;
+        {
+            lc_island isl = lc_islands_get(w->islands, handover);
+            t0 += t_handover;
+            w->time = t0;
+            st = contact_island(w, &isl, handover, time0 + dt - t0, time0, backup, stuck);
+            if (st != LC_OK || *stuck) return st;
+            for (i = 0; i < isl.nrows; ++i) excluded[isl.rows[i]] = 1;
+            any_contact = 1;
+        }
+    }
+    if (any_contact) w->end_touch_count = -1;
+    return st;
+}
+
+/* Back to the state the step began in, for another try. */
+static void restart_step(lc_world *w, const double *backup, const uint8_t *marks0, double time0)
+{
+    w->last.island_retries++;
+    memcpy(w->state, backup, (size_t)w->count * 6 * sizeof(double));
+    memcpy(w->rests_dissipative, marks0, (size_t)w->count);
+    w->time = time0;
+    w->contact_count = 0;
+    lc_contact_regime_retry(w->contact);
+}
+
+lc_status lc_world_step(lc_world *w, double dt)
+{
+    size_t bytes;
+    double *backup, *reach = NULL, time0;
+    uint8_t *marks0;
+    int i, try, marks_known = 0;
+    lc_status st;
+    if (w == NULL) return LC_ERR_NULL;
+    if (!isfinite(dt)) return lc_fail(w, LC_ERR_NOT_FINITE, "dt is not finite (%g)", dt);
+    if (!(dt > 0.0) || dt > 1.0) return lc_fail(w, LC_ERR_OUT_OF_RANGE, "dt = %g is outside (0, 1] s", dt);
+    memset(&w->last, 0, sizeof w->last);
+    w->step_t0 = lc_stage_begin(w);
+    w->last.steps = 1;
+    w->step_dt = dt;
+    w->contact_count = 0;
+    time0 = w->time;
+    bytes = (size_t)(w->count > 0 ? w->count : 1) * 6 * sizeof(double);
+    backup = lc_buf_get(&w->b_backup, bytes);
+    marks0 = lc_buf_get(&w->b_marks0, (size_t)(w->count > 0 ? w->count : 1));
+    w->force_event = lc_buf_get(&w->b_force_event, (size_t)(w->count > 0 ? w->count : 1));
+    if (!backup || !marks0 || !w->force_event) return lc_fail(w, LC_ERR_NO_MEMORY, "out of memory in step");
+    memset(w->force_event, 0, (size_t)(w->count > 0 ? w->count : 1));
+    if (w->count == 0) {
+        /* nothing to move: time still passes */
+        w->time += dt;
+        lc_stage_end(w, &w->last.time_step, w->step_t0);
+        add_counters(&w->total, &w->last);
+        w->error[0] = '\0';
+        return LC_OK;
+    }
+    memcpy(backup, w->state, (size_t)w->count * 6 * sizeof(double));
+    if (lc_regime_refresh(w) != 0 || lc_contact_regime_begin_step(w->contact) != 0)
+        return step_failed(w, backup, time0, LC_ERR_NO_MEMORY, "out of memory during the step");
+    memcpy(marks0, w->rests_dissipative, (size_t)w->count);
+    /* Tries: a try whose bodies went where their islands' build did not foresee is taken again with
+     * those islands grown to where they went (LC_MAX_ISLAND_TRIES at most); one whose contact island
+     * ended overlapping for no such reason is taken again with that island in the event regime (once
+     * per island: its rows stay marked for the step, so this ends). */
+    for (try = 0;; ++try) {
+        int found = 0, stuck = 0;
+        st = advance_islands(w, dt, time0, backup, reach, &marks_known, &stuck);
+        if (st != LC_OK) {
+            memcpy(w->rests_dissipative, marks0, (size_t)w->count);
+            return st;
+        }
+        if (try < LC_MAX_ISLAND_TRIES - 1) {
+            if (reach == NULL) {
+                reach = lc_buf_get(&w->b_reach, (size_t)w->count * 4 * sizeof(double));
+                if (reach == NULL) return step_failed(w, backup, time0, LC_ERR_NO_MEMORY, "out of memory during the step");
+                for (i = 0; i < w->count; ++i) {
+                    reach[4 * i] = 1.0;
+                    reach[4 * i + 2] = -1.0;
+                }
+            }
+            found = unforeseen_pairs(w, backup, reach);
+            if (found < 0) return step_failed(w, backup, time0, LC_ERR_NO_MEMORY, "out of memory during the step");
+        }
+        if (found == 0 && stuck) {
+            lc_island isl = lc_islands_get(w->islands, stuck - 1);
+            for (i = 0; i < isl.nrows; ++i) w->force_event[isl.rows[i]] = 1;
+            --try;
+        } else if (found == 0) {
+            break;
+        }
+        restart_step(w, backup, marks0, time0);
+    }
+    w->time = time0 + dt;
     for (i = 0; i < w->count * 6; ++i)
         if (!isfinite(w->state[i])) return step_failed(w, backup, time0, LC_ERR_NUMERIC, "the state became non-finite");
+    /* the marks describe the end state unless the event regime could not tell (the next step looks) */
+    w->regime_edits = marks_known ? w->edits : w->edits - 1;
     lc_stage_end(w, &w->last.time_step, w->step_t0);
     add_counters(&w->total, &w->last);
     w->error[0] = '\0';
     return LC_OK;
-oom:
-    return step_failed(w, backup, time0, LC_ERR_NO_MEMORY, "out of memory during the step");
 }

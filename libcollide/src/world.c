@@ -5,6 +5,8 @@
 #include <stdlib.h>
 #include <string.h>
 #include "world.h"
+#include "islands.h"
+#include "contact_regime.h"
 
 /* ---- scratch and errors ------------------------------------------------------------------ */
 
@@ -98,6 +100,9 @@ lc_world_def lc_default_world_def(void)
     d.lcp_tolerance = 1e-10;
     d.broadphase = LC_BROADPHASE_AUTO;
     d.broadphase_threshold = 32;
+    d.regime = LC_REGIME_AUTO;
+    d.contact_iterations = 30;
+    d.contact_tolerance = 1e-10;
     return d;
 }
 
@@ -170,6 +175,10 @@ static lc_status validate_world_def(lc_world *w, const lc_world_def *d)
     if (d->broadphase != LC_BROADPHASE_AUTO && d->broadphase != LC_BROADPHASE_BRUTE_FORCE && d->broadphase != LC_BROADPHASE_SORT_AND_SWEEP)
         return lc_fail(w, LC_ERR_BAD_ENUM, "broadphase = %d is not an lc_broadphase", (int)d->broadphase);
     CHECK_IRANGE(w, d->broadphase_threshold, 2, 1000000, "broadphase_threshold");
+    if (d->regime != LC_REGIME_AUTO && d->regime != LC_REGIME_EVENT && d->regime != LC_REGIME_CONTACT)
+        return lc_fail(w, LC_ERR_BAD_ENUM, "regime = %d is not an lc_regime", (int)d->regime);
+    CHECK_IRANGE(w, d->contact_iterations, 1, 1000000, "contact_iterations");
+    CHECK_RANGE(w, d->contact_tolerance, 0.0, 1.0, "contact_tolerance");
     return LC_OK;
 }
 
@@ -186,7 +195,9 @@ lc_world *lc_world_create(const lc_world_def *def, char *errbuf, size_t errbuf_l
     s = validate_world_def(w, def);
     if (s == LC_OK) {
         w->lcp = lc_lcp_workspace_create();
-        if (w->lcp == NULL) s = lc_fail(w, LC_ERR_NO_MEMORY, "out of memory");
+        w->islands = lc_islands_create();
+        w->contact = lc_contact_regime_create();
+        if (w->lcp == NULL || w->islands == NULL || w->contact == NULL) s = lc_fail(w, LC_ERR_NO_MEMORY, "out of memory");
     }
     if (s != LC_OK) {
         if (errbuf && errbuf_len) snprintf(errbuf, errbuf_len, "%s", w->error);
@@ -208,8 +219,13 @@ void lc_world_destroy(lc_world *w)
     free(w->ids); free(w->state); free(w->mass); free(w->inertia); free(w->inv_mass); free(w->inv_inertia);
     free(w->is_static); free(w->elasticity); free(w->friction); free(w->ext_force); free(w->ext_torque);
     free(w->shape); free(w->trig); free(w->thrusters); free(w->thruster_count); free(w->id_to_row);
-    free(w->springs); free(w->contacts);
+    free(w->springs); free(w->contacts); free(w->rests_dissipative);
     lc_lcp_workspace_destroy(w->lcp);
+    lc_islands_destroy(w->islands);
+    lc_buf_free(&w->b_event_rows); lc_buf_free(&w->b_excluded);
+    lc_buf_free(&w->b_marks0); lc_buf_free(&w->b_reach); lc_buf_free(&w->b_reach_boxes);
+    lc_buf_free(&w->b_force_event);
+    lc_contact_regime_destroy(w->contact);
     lc_buf_free(&w->b_state0); lc_buf_free(&w->b_state1); lc_buf_free(&w->b_backup);
     for (i = 0; i < 4; ++i) lc_buf_free(&w->b_k[i]);
     lc_buf_free(&w->b_tmp); lc_buf_free(&w->b_acc); lc_buf_free(&w->b_touch); lc_buf_free(&w->b_rest);
@@ -292,7 +308,7 @@ static int reserve_bodies(lc_world *w, int need)
     GROW(w->ids, cap); GROW(w->mass, cap); GROW(w->inertia, cap); GROW(w->inv_mass, cap);
     GROW(w->inv_inertia, cap); GROW(w->is_static, cap); GROW(w->elasticity, cap); GROW(w->friction, cap);
     GROW(w->ext_force, cap); GROW(w->ext_torque, cap); GROW(w->shape, cap); GROW(w->trig, cap); GROW(w->thrusters, cap);
-    GROW(w->thruster_count, cap);
+    GROW(w->thruster_count, cap); GROW(w->rests_dissipative, cap);
     GROW(w->state, (size_t)cap * LC_STATE_SIZE);
     w->capacity = cap;
     return 1;
@@ -390,6 +406,7 @@ lc_status lc_world_add_body(lc_world *w, const lc_body_def *d, lc_body_id *out_i
     w->ext_force[row] = lc_v(0.0, 0.0);
     w->ext_torque[row] = 0.0;
     w->thruster_count[row] = 0;
+    w->rests_dissipative[row] = 0;
     return ok(w);
 }
 
@@ -466,6 +483,7 @@ lc_status lc_world_remove_body(lc_world *w, lc_body_id id)
     SHIFT(w->ids, 1); SHIFT(w->mass, 1); SHIFT(w->inertia, 1); SHIFT(w->inv_mass, 1); SHIFT(w->inv_inertia, 1);
     SHIFT(w->is_static, 1); SHIFT(w->elasticity, 1); SHIFT(w->friction, 1); SHIFT(w->ext_force, 1);
     SHIFT(w->ext_torque, 1); SHIFT(w->shape, 1); SHIFT(w->trig, 1); SHIFT(w->thrusters, 1); SHIFT(w->thruster_count, 1);
+    SHIFT(w->rests_dissipative, 1);
     SHIFT(w->state, LC_STATE_SIZE);
 #undef SHIFT
     w->count--;

@@ -81,6 +81,7 @@ struct lc_world {
     lc_trig *trig;           /* per body; a cache, so written through even a const lc_world * */
     lc_thruster (*thrusters)[LC_MAX_THRUSTERS];
     int *thruster_count;
+    uint8_t *rests_dissipative; /* touched a pair with e < 1 at the end of the last step (regime.c) */
 
     lc_body_id next_body_id;
     int *id_to_row;          /* indexed by id, -1 = removed */
@@ -94,6 +95,15 @@ struct lc_world {
     int contact_count, contact_cap;
 
     lc_counters last, total;
+
+    struct lc_islands *islands;          /* islands.c */
+    struct lc_contact_regime *contact;   /* contact_regime.c */
+    unsigned long regime_edits;          /* regime.c: `edits` when rests_dissipative last described the state */
+    const uint8_t *excluded;             /* step.c: dynamic rows left out of every pair (other islands) */
+    lc_buf b_event_rows, b_excluded;     /* step.c */
+    lc_buf b_marks0, b_reach, b_reach_boxes; /* step.c: rests_dissipative at the start, the tries' reach */
+    lc_buf b_force_event;
+    uint8_t *force_event;                /* step.c: rows an earlier try of this step sends to the event regime */
 
     /* scratch, reused between steps */
     lc_lcp_workspace *lcp;
@@ -172,6 +182,11 @@ void lc_touch_update(const lc_world *w, const double *state, lc_touch *t);
  * Returns the new count or -1 on allocation failure. */
 int lc_collect_touches(const lc_world *w, const double *state, int a, int b, double max_gap,
                        lc_buf *buf, int count);
+/* The same with the edges' extent grown by `extent` instead of max_gap, and only for vertices within
+ * `extent` of the edge's line: a speculative search far beyond contact_distance must not take a vertex
+ * passing just beyond the end of an edge (over a seam between two slabs) for one that will hit it. */
+int lc_collect_touches_within(const lc_world *w, const double *state, int a, int b, double max_gap, double extent,
+                              lc_buf *buf, int count);
 /* Crossing found between two states: vertex of row a entered edge of row b. */
 /* t_hi: a time (from the interval's start) by which the vertex is known to be inside. */
 typedef struct lc_crossing { int a, b, vertex, edge; double toi, t_hi; } lc_crossing;
@@ -191,6 +206,10 @@ int lc_broad_phase(lc_world *w, const double *s0, const double *s1, double margi
  * bound of their distance that, unlike the bounding circles, stays tight for a block over a long
  * floor or beside a wall (boxes from the per-body cache). */
 double lc_bounds_gap(const lc_world *w, const double *state, int a, int b);
+/* Body row's box over the interval (both end poses) grown by margin: x0, y0, x1, y1. */
+void lc_swept_box(lc_world *w, const double *s0, const double *s1, int row, double margin, double out[4]);
+/* Candidate pairs, as lc_broad_phase, of given boxes (4 doubles per row: x0, y0, x1, y1). */
+int lc_broad_phase_boxes(lc_world *w, const double *boxes4, lc_buf *buf);
 /* The same, restricted to pairs with at least one of the nlist bodies in list (marked[row] != 0). */
 int lc_broad_phase_of(lc_world *w, const double *s0, const double *s1, double margin, const uint8_t *marked,
                       const int *list, int nlist, lc_buf *buf);
@@ -227,6 +246,9 @@ int lc_sparse_lcp(lc_world *w, const lc_touch *t, int m, int tangent, const doub
  * hold zeros). Each returns 0 (no gravity: no guess), or -1 on allocation failure. */
 /* f[i]: N, the weight each touch carries when loads are shared among a body's supports by the lever rule. */
 int lc_static_load_forces(lc_world *w, const lc_touch *t, int m, double *f);
+/* The same over an island: local[row] maps its dynamic rows to 0..n-1 (static rows to -1), rows[k] back. */
+int lc_static_load_forces_of(lc_world *w, const lc_touch *t, int m, const int *local, const int *rows, int n,
+                             double *f);
 /* lam[i]: kg*m, the projection's multipliers that lift every body by the gaps below it (deficit[i], m,
  * what touch i is short of the contact gap). */
 int lc_static_load_lifts(lc_world *w, const lc_touch *t, int m, const double *deficit, double *lam);
@@ -252,6 +274,12 @@ int lc_integrate_rows(lc_world *w, const double *s0, double h, const int *rows, 
  * restitution when `elastic`, else perfectly inelastic. Returns the number of points that received an
  * impulse, or -1 on allocation failure. */
 int lc_resolve_impacts(lc_world *w, double *state, lc_touch *t, int n, int elastic);
+/* Approach speed (m/s) above which an impact of a pair of this elasticity bounces. */
+double lc_bounce_speed(const lc_world *w, double elasticity);
+
+/* ---- step.c: results ---- */
+/* Appends a contact of the step in progress (a touch at its current geometry). 0, or -1 without memory. */
+int lc_push_contact(lc_world *w, const lc_touch *t, lc_contact_kind kind);
 
 /* ---- time_of_impact.c ---- */
 /* Time in [0, h] at which the crossing's gap reaches the contact gap; integrates the listed rows. */

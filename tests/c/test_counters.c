@@ -1,4 +1,7 @@
 /* test_counters: "model only what a scene needs", proven by the work counters (exact integers).
+ * Cases (2) and (4)-(7) check the event regime's own machinery (resting contact forces, quiet advances,
+ * solver products, serial impacts) and set regime = LC_REGIME_EVENT: in the default AUTO those scenes'
+ * resting bodies go to the contact regime (regime.h), whose counters test_contact_regime.c checks.
  * (1) g = 0, two bodies drifting apart, nothing touches: 0 contact solves, 0 TOI searches, 0
  *     collisions, 0 resting contacts, 0 impulse solves; with no force of any kind, no force
  *     evaluations either (free flight is advanced in closed form: analytic_advances > 0).
@@ -11,7 +14,8 @@
  *     resting contact spends time in every stage, the six disjoint stages sum to no more than the
  *     whole step (they do not overlap; the remainder is bookkeeping between them), and the contact
  *     force solves fit inside the integration and time-of-impact stages that run them; off again,
- *     no more time is added; 2 is refused with a message. The physics is the same bit for bit.
+ *     no more time is added; 2 is refused with a message. The physics is the same bit for bit. In
+ *     AUTO the same pile settles in the contact regime, whose time is its own disjoint stage.
  * (5) a resting stack is advanced with two force evaluations per interval (see quiet_rest).
  * (6) a frictional pile in motion (a heavy box dropped into a base-4 pyramid, mu 0.6): every step
  *     succeeds and its force solves stay within 120 products of A per force evaluation. There the
@@ -64,8 +68,10 @@ static void nothing_touches(void)
 static void resting_is_counted(void)
 {
     lc_world_def d = lc_default_world_def();
-    lc_world *w = sc_world(&d);
+    lc_world *w;
     lc_counters tot;
+    d.regime = LC_REGIME_EVENT;
+    w = sc_world(&d);
     if (!w) return;
     lc_world_add_walls(w, -5.0, 0.0, 5.0, 10.0, 1.0, 0.5, NULL);
     sc_box(w, 1.0, 1.0, 0.0, 0.5 + 1e-7, 0.0, 0, 0, 0, 1.0, 0.5);
@@ -96,6 +102,7 @@ static lc_world *spring_lift(double resting_speed, lc_body_id *box)
     lc_world *w;
     d.gravity.y = -10.0;
     d.resting_speed = resting_speed;
+    d.regime = LC_REGIME_EVENT;
     w = sc_world(&d);
     if (!w) return NULL;
     sc_static_box(w, 10.0, 1.0, 0.0, -0.5, 0.0);
@@ -118,6 +125,7 @@ static void quiet_rest(void)
     double y0, dy;
     int k, quiet_steps = 0;
     d.gravity.y = -10.0;
+    d.regime = LC_REGIME_EVENT;
     w = sc_world(&d);
     if (!w) return;
     sc_static_box(w, 10.0, 1.0, 0.0, -0.5, 0.0);
@@ -248,12 +256,14 @@ static void broadphase_equivalence(void)
 
 /* Seven blocks of 0.5 m dropped onto a floor at e = 0.5 and onto each other: impacts, TOI searches,
  * resting contact and projections all happen within the 200 steps. Returns the state hash. */
-static uint64_t timed_pile(int timing, lc_counters *tot)
+static uint64_t timed_pile(int timing, lc_regime regime, lc_counters *tot)
 {
     lc_world_def d = lc_default_world_def();
-    lc_world *w = sc_world(&d);
+    lc_world *w;
     uint64_t h;
     int i;
+    d.regime = regime;
+    w = sc_world(&d);
     if (!w) return 0;
     lc_world_add_walls(w, -3.0, 0.0, 3.0, 10.0, 1.0, 0.5, NULL);
     for (i = 0; i < 7; i++)
@@ -280,17 +290,22 @@ static uint64_t timed_pile(int timing, lc_counters *tot)
 
 static void stage_timing(void)
 {
-    lc_counters off, on;
-    uint64_t h_off = timed_pile(0, &off), h_on = timed_pile(1, &on);
+    lc_counters off, on, aoff, aon;
+    uint64_t h_off = timed_pile(0, LC_REGIME_EVENT, &off), h_on = timed_pile(1, LC_REGIME_EVENT, &on);
+    uint64_t ha_off = timed_pile(0, LC_REGIME_AUTO, &aoff), ha_on = timed_pile(1, LC_REGIME_AUTO, &aon);
     double stages = on.time_detection + on.time_integration + on.time_toi_search + on.time_impulses + on.time_projection;
-    printf("stage timing, 200 steps of a 7-block pile: step %.3e s = detection %.3e + integration %.3e + toi %.3e + "
-           "impulses %.3e + projection %.3e (+ %.3e between); contact forces %.3e inside; %llu impacts\n",
-           on.time_step, on.time_detection, on.time_integration, on.time_toi_search, on.time_impulses,
+    double astages = aon.time_detection + aon.time_integration + aon.time_toi_search + aon.time_impulses +
+                     aon.time_projection + aon.time_contact_regime;
+    printf("stage timing, 200 steps of a 7-block pile in the event regime: step %.3e s = detection %.3e + integration "
+           "%.3e + toi %.3e + impulses %.3e + projection %.3e (+ %.3e between); contact forces %.3e inside; %llu "
+           "impacts\n", on.time_step, on.time_detection, on.time_integration, on.time_toi_search, on.time_impulses,
            on.time_projection, on.time_step - stages, on.time_contact_forces, (unsigned long long)on.collisions);
+    printf("the same pile, regime AUTO: step %.3e s, of it contact regime %.3e s, event stages %.3e s\n",
+           aon.time_step, aon.time_contact_regime, astages - aon.time_contact_regime);
     CHECK(off.time_step == 0.0 && off.time_detection == 0.0 && off.time_integration == 0.0 && off.time_toi_search == 0.0 &&
-          off.time_impulses == 0.0 && off.time_projection == 0.0 && off.time_contact_forces == 0.0,
-          "%s", "timing off by default: every time_* counter is 0");
-    CHECK(h_on == h_off, "%s", "timing changes no physics (same state hash)");
+          off.time_impulses == 0.0 && off.time_projection == 0.0 && off.time_contact_forces == 0.0 &&
+          aoff.time_contact_regime == 0.0, "%s", "timing off by default: every time_* counter is 0");
+    CHECK(h_on == h_off && ha_on == ha_off, "%s", "timing changes no physics (same state hash)");
     CHECK(on.collisions > 0 && on.toi_searches > 0 && on.contact_solves > 0 && on.position_projections > 0,
           "the scene exercises every stage (impacts %llu, toi %llu, contact solves %llu, projections %llu)",
           (unsigned long long)on.collisions, (unsigned long long)on.toi_searches,
@@ -300,6 +315,10 @@ static void stage_timing(void)
     CHECK(stages <= on.time_step, "disjoint stages sum to %.6e s, more than the whole steps' %.6e s", stages, on.time_step);
     CHECK(on.time_contact_forces <= on.time_integration + on.time_toi_search + on.time_detection,
           "%s", "contact forces run inside integration (and the TOI searches' and swept checks' integrations)");
+    CHECK(aon.contact_islands > 0 && aon.time_contact_regime > 0.0, "the pile settles in the contact regime, timed "
+          "(%llu island steps, %.3e s)", (unsigned long long)aon.contact_islands, aon.time_contact_regime);
+    CHECK(astages <= aon.time_step, "disjoint stages with the contact regime sum to %.6e s, more than the steps' %.6e s",
+          astages, aon.time_step);
 }
 
 static void pile_in_motion(int exact_max, double bound)
@@ -313,6 +332,7 @@ static void pile_in_motion(int exact_max, double bound)
     d.gravity.x = 0.0;
     d.gravity.y = -10.0;
     d.lcp_exact_max = exact_max;
+    d.regime = LC_REGIME_EVENT;
     w = sc_world(&d);
     if (!w) return;
     sc_pyramid(w, base, 0.6, NULL);
@@ -352,6 +372,7 @@ static double drop_on_stack(int exact_max, double e, unsigned long long *serial)
     int i, k;
     double speed = -1.0;
     d.lcp_exact_max = exact_max;
+    d.regime = LC_REGIME_EVENT;
     w = sc_world(&d);
     if (!w) return -1.0;
     lc_body_set_material(w, sc_static_box(w, 20.0, 1.0, 0.0, -0.5, e), e, 0.6);

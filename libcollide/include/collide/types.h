@@ -78,6 +78,15 @@ typedef enum lc_stabilization {
     LC_STABILIZE_VELOCITY_AND_DISTANCE = 2   /* ... and the gap to contact_gap by force (leaves ~contact_gap/h of speed) */
 } lc_stabilization;
 
+/* How an island (bodies that touch or may meet within a step, docs/contact_regime.md) is advanced. */
+typedef enum lc_regime {
+    LC_REGIME_AUTO = 0,    /* each island by what it needs (default): islands resting on a touch between
+                              bodies that are not perfectly elastic (e < 1) in the contact regime, the
+                              others (free flight, isolated impacts, e = 1 chains) in the event regime */
+    LC_REGIME_EVENT = 1,   /* every island event by event: exact times of impact, eq. 11, contact forces */
+    LC_REGIME_CONTACT = 2  /* every island by velocity-level time stepping of contact impulses */
+} lc_regime;
+
 typedef enum lc_body_type {
     LC_BODY_DYNAMIC = 0,
     LC_BODY_STATIC = 1    /* infinite mass and inertia, never moves */
@@ -109,6 +118,10 @@ typedef struct lc_world_def {
     double lcp_tolerance;          /* relative residual for the iterative solver, [0, 1], default 1e-10 */
     lc_broadphase broadphase;      /* default LC_BROADPHASE_AUTO */
     int broadphase_threshold;      /* body count at which AUTO switches to sort-and-sweep, [2, 1e6], default 32 */
+    lc_regime regime;              /* default LC_REGIME_AUTO */
+    int contact_iterations;        /* contact regime: most solver sweeps per solve, [1, 1e6], default 30 */
+    double contact_tolerance;      /* contact regime: m/s, a solve stops at a sweep that changes no point's
+                                      velocity by more than this, [0, 1], default 1e-10 */
 } lc_world_def;
 
 /* A body. Start from lc_default_body_def(). Vertices are in the body's local frame; the centre of
@@ -210,11 +223,28 @@ typedef struct lc_counters {
     uint64_t impulse_solves;          /* complementarity solves for impulses */
     uint64_t position_projections;    /* end-of-step corrections of points found inside another body */
     uint64_t quiet_advances;          /* RK4 intervals of resting bodies taken with two force evaluations */
+    uint64_t islands;                 /* islands advanced (docs/contact_regime.md) */
+    uint64_t island_retries;          /* steps taken again with islands grown to where the bodies went */
+    uint64_t contact_islands;         /* of those, advanced in the contact regime */
+    uint64_t contact_points;          /* contact points in the contact regime's solves */
+    uint64_t contact_sweeps;          /* Gauss-Seidel sweeps of those solves */
+    uint64_t contact_exact_solves;    /* of those solves, taken exactly by pivoting (few points) */
+    uint64_t contact_cuts;            /* contact-regime steps cut at a located stick-slip or arrival */
+    uint64_t contact_precise_retries; /* contact-regime island steps taken again with converged solves */
+    uint64_t energy_clamps;           /* contact-regime island steps whose energy gain was taken back from
+                                         the island's kinetic energy */
+    uint64_t contact_unresolved;      /* contact-regime steps of islands too large for the event regime kept
+                                         with an overlap or an energy gain above the engine's allowance
+                                         (docs/contact_regime.md, "Guarantees") */
+    double max_unresolved_overlap;    /* m, deepest overlap such a step left */
+    double max_unresolved_energy;     /* J, largest energy gain such a step kept */
+    double max_contact_residual;      /* m/s, largest residual of a contact-regime solve (its stopping rule) */
     double max_lcp_residual;          /* largest residual of an iterative contact-force solve: relative for
                                          groups up to lcp_exact_max, m/s^2 of relative acceleration above */
     /* s of wall time per pipeline stage, measured only while lc_world_set_stage_timing is on (else 0).
-     * The first six do not overlap and sum to at most time_step; time_contact_forces lies inside
-     * time_integration and time_toi_search (the integrator solves the contact forces). */
+     * The first six and time_contact_regime do not overlap and sum to at most time_step;
+     * time_contact_forces lies inside time_integration and time_toi_search (the integrator solves the
+     * contact forces). */
     double time_step;                 /* the whole lc_world_step */
     double time_detection;            /* broadphase, touches, crossings, swept checks */
     double time_integration;          /* advancing the world over trial intervals and to event times */
@@ -222,6 +252,8 @@ typedef struct lc_counters {
     double time_impulses;             /* impulse solves of impacts */
     double time_projection;           /* end-of-step position projection */
     double time_contact_forces;       /* resting-contact force solves, wherever they ran */
+    double time_contact_regime;       /* contact-regime island steps, all their stages (disjoint from the
+                                         six above) */
 } lc_counters;
 
 #endif /* COLLIDE_TYPES_H */

@@ -1,0 +1,723 @@
+/* The contact regime (contact_regime.h, docs/contact_regime.md): one island advanced by velocity-level
+ * time stepping. A step of h is
+ *   1. contacts: every vertex-edge point of the island's pairs within contact_distance, or within the
+ *      distance the pair can close in the step (speculative points);
+ *   2. impacts: points touching (or, in a large island, arriving within the first half of the step)
+ *      that approach get the compression impulse that stops every approach, then Poisson's
+ *      restitution e j_c where their approach was fast enough to bounce, then a second compression
+ *      that stops what the restitution drove into other touches;
+ *   3. flow: one complementarity problem in the contact impulses over h: with v = v_0 + h M^-1 F + M^-1
+ *      J^T lambda, each point's normal velocity at the end keeps its gap at or above the contact gap
+ *      under the trapezoidal position update (u_n >= -u_n0 - 2 (gap - contact_gap)^+ / h), Coulomb
+ *      friction in the exact 2D cone, warm-started from the last step's forces (contact_cache.c),
+ *      solved exactly for few points (contact_exact.c) or by nonsmooth Gauss-Seidel (contact_solver.c);
+ *   4. in small islands, a stick-slip transition or a new contact's arrival inside the step cuts the
+ *      step there, and the rest is taken again from step 1;
+ *   5. positions: x += h (v_0 + v) / 2 (exact under constant forces);
+ *   6. a projection moves overlapping points out by the smallest mass-weighted displacement, and an
+ *      island without driving forces that still ends with more energy than it began with gives the
+ *      excess back from its kinetic energy. An island this cannot keep apart, or whose kinetic energy
+ *      cannot pay, is taken again by the event regime (step.c). */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include "contact_regime.h"
+#include "contact_cache.h"
+#include "contact_exact.h"
+#include "contact_solver.h"
+#include "tunables.h"
+#include "world.h"
+
+struct lc_contact_regime {
+    lc_contact_cache *cache;
+    lc_buf b_local;      /* int per world row: the row's index in the island being advanced, else -1 */
+    int local_rows;      /* rows of b_local that hold -1 outside an island */
+    lc_buf b_touch;      /* the sub-step's touches */
+    lc_buf b_end;        /* touches at the step's end */
+    lc_buf b_rows;       /* solver rows of the flow */
+    lc_buf b_irows;      /* solver rows of the impacts and of the projection */
+    lc_buf b_body;       /* per island body: see body_arrays */
+    lc_buf b_start;      /* island rows' states at the step's start, nb x 6 */
+    lc_buf b_acc;        /* world-sized scratch for lc_applied_accelerations */
+    lc_buf b_hash;       /* end touch -> flow row */
+    lc_buf b_cold, b_cold_load; /* cold_start: the touching points, their loads and rows */
+    lc_buf b_mprgp;      /* project_by_mprgp's vectors */
+    lc_buf b_exact;      /* contact_exact.c's scratch */
+    lc_buf b_vstart;     /* start velocities of an exact solve */
+};
+
+lc_contact_regime *lc_contact_regime_create(void)
+{
+    lc_contact_regime *cr = calloc(1, sizeof *cr);
+    if (cr == NULL) return NULL;
+    cr->cache = lc_contact_cache_create();
+    if (cr->cache == NULL) {
+        free(cr);
+        return NULL;
+    }
+    return cr;
+}
+
+void lc_contact_regime_destroy(lc_contact_regime *cr)
+{
+    if (cr == NULL) return;
+    lc_contact_cache_destroy(cr->cache);
+    lc_buf_free(&cr->b_local);
+    lc_buf_free(&cr->b_touch);
+    lc_buf_free(&cr->b_end);
+    lc_buf_free(&cr->b_rows);
+    lc_buf_free(&cr->b_irows);
+    lc_buf_free(&cr->b_body);
+    lc_buf_free(&cr->b_start);
+    lc_buf_free(&cr->b_acc);
+    lc_buf_free(&cr->b_hash);
+    lc_buf_free(&cr->b_cold);
+    lc_buf_free(&cr->b_cold_load);
+    lc_buf_free(&cr->b_mprgp);
+    lc_buf_free(&cr->b_exact);
+    lc_buf_free(&cr->b_vstart);
+    free(cr);
+}
+
+int lc_contact_regime_begin_step(lc_contact_regime *cr) { return lc_contact_cache_next_step(cr->cache); }
+
+void lc_contact_regime_retry(lc_contact_regime *cr) { lc_contact_cache_drop_stored(cr->cache); }
+
+void lc_contact_regime_forget(lc_contact_regime *cr) { lc_contact_cache_clear(cr->cache); }
+
+/* The island's bodies as the solver sees them: velocities at the start of the sub-step (v0), the
+ * solver's velocities (v), inverse mass and inertia, applied accelerations (acc), projection
+ * displacements (disp). */
+typedef struct body_arrays {
+    int n;
+    double *v0, *v, *inv_mass, *inv_inertia, *acc, *disp;
+} body_arrays;
+
+typedef struct island_ctx {
+    lc_world *w;
+    lc_contact_regime *cr;
+    const lc_island *isl;
+    int *local;          /* world row -> island index, -1 outside */
+    body_arrays b;
+    int small;           /* transitions are located (LC_CONTACT_LOCATE_MAX_BODIES) */
+    int precise;         /* solves run to convergence (LC_CONTACT_PRECISE_SWEEPS, _EXACT_POINTS) */
+    double residual;
+    double overlap;      /* m, deepest overlap the last advance() left */
+    double unpaid;       /* J, energy gain the last advance() kept (its kinetic energy could not pay) */
+} island_ctx;
+
+static lc_contact_key key_of(const lc_world *w, const lc_touch *t)
+{
+    lc_contact_key k;
+    k.a = w->ids[t->a];
+    k.b = w->ids[t->b];
+    k.vertex = t->vertex;
+    k.edge = t->edge;
+    return k;
+}
+
+static int map_island(island_ctx *c)
+{
+    lc_world *w = c->w;
+    lc_contact_regime *cr = c->cr;
+    int i, nb = c->isl->nrows;
+    double *d;
+    c->local = lc_buf_get(&cr->b_local, (size_t)(w->count > 0 ? w->count : 1) * sizeof(int));
+    if (c->local == NULL) return -1;
+    if (cr->local_rows > w->count) cr->local_rows = w->count;
+    for (i = cr->local_rows; i < w->count; ++i) c->local[i] = -1;
+    cr->local_rows = w->count;
+    for (i = 0; i < nb; ++i) c->local[c->isl->rows[i]] = i;
+    d = lc_buf_get(&cr->b_body, (size_t)(nb > 0 ? nb : 1) * 14 * sizeof(double));
+    if (d == NULL) return -1;
+    c->b.n = nb;
+    c->b.v0 = d;
+    c->b.v = d + 3 * nb;
+    c->b.acc = d + 6 * nb;
+    c->b.disp = d + 9 * nb;
+    c->b.inv_mass = d + 12 * nb;
+    c->b.inv_inertia = d + 13 * nb;
+    for (i = 0; i < nb; ++i) {
+        int r = c->isl->rows[i];
+        c->b.inv_mass[i] = w->inv_mass[r];
+        c->b.inv_inertia[i] = w->inv_inertia[r];
+    }
+    return 0;
+}
+
+static void unmap_island(island_ctx *c)
+{
+    int i;
+    for (i = 0; i < c->isl->nrows; ++i) c->local[c->isl->rows[i]] = -1;
+}
+
+/* Applied accelerations of the island's bodies at the current state into b.acc. */
+static int applied(island_ctx *c)
+{
+    lc_world *w = c->w;
+    int nb = c->b.n, i;
+    double *acc = lc_buf_get(&c->cr->b_acc, (size_t)(w->count > 0 ? w->count : 1) * 3 * sizeof(double));
+    if (acc == NULL) return -1;
+    lc_applied_accelerations(w, w->state, c->isl->rows, nb, acc);
+    for (i = 0; i < nb; ++i) memcpy(&c->b.acc[i * 3], &acc[c->isl->rows[i] * 3], 3 * sizeof(double));
+    return 0;
+}
+
+/* How far a pair's points can close on each other within h at most: the relative speed of their
+ * farthest points and the relative applied acceleration. */
+static double closing_bound(const island_ctx *c, int a, int b, double h)
+{
+    const lc_world *w = c->w;
+    const double *sa = &w->state[a * 6], *sb = &w->state[b * 6];
+    double dvx = sa[SVX] - sb[SVX], dvy = sa[SVY] - sb[SVY], v, acc = 0.0;
+    int la = c->local[a], lb = c->local[b];
+    v = sqrt(dvx * dvx + dvy * dvy) + fabs(sa[SW]) * w->shape[a].radius + fabs(sb[SW]) * w->shape[b].radius;
+    {
+        double ax = 0.0, ay = 0.0, al = 0.0;
+        if (la >= 0) { ax += c->b.acc[la * 3]; ay += c->b.acc[la * 3 + 1]; al += fabs(c->b.acc[la * 3 + 2]) * w->shape[a].radius; }
+        if (lb >= 0) { ax -= c->b.acc[lb * 3]; ay -= c->b.acc[lb * 3 + 1]; al += fabs(c->b.acc[lb * 3 + 2]) * w->shape[b].radius; }
+        acc = sqrt(ax * ax + ay * ay) + al;
+    }
+    return h * v + 0.5 * h * h * acc;
+}
+
+/* Every contact point of the island's pairs at the current state: within contact_distance plus
+ * `reach`, or (speculative) within what the pair can close in h. Returns the count or -1. */
+static int collect(island_ctx *c, double h, lc_buf *buf, int speculative, double reach)
+{
+    lc_world *w = c->w;
+    int k, n = 0;
+    for (k = 0; k < c->isl->npairs; ++k) {
+        int a = c->isl->pairs[2 * k], b = c->isl->pairs[2 * k + 1];
+        double gap = w->def.contact_distance + reach + (speculative ? closing_bound(c, a, b, h) : 0.0);
+        n = lc_collect_touches_within(w, w->state, a, b, gap, w->def.contact_distance, buf, n);
+        if (n < 0) return -1;
+    }
+    return n;
+}
+
+static void make_row(const island_ctx *c, const lc_touch *t, lc_contact_row *r)
+{
+    const lc_world *w = c->w;
+    lc_vec2 tg = lc_tangent_of(t->n);
+    r->a = w->is_static[t->a] ? -1 : c->local[t->a];
+    r->b = w->is_static[t->b] ? -1 : c->local[t->b];
+    r->nx = t->n.x;
+    r->ny = t->n.y;
+    r->rna = lc_cross(t->ra, t->n);
+    r->rnb = lc_cross(t->rb, t->n);
+    r->rta = lc_cross(t->ra, tg);
+    r->rtb = lc_cross(t->rb, tg);
+    r->mu = t->friction;
+    r->slip = 0;
+    r->target_n = 0.0;
+    r->lambda_n = r->lambda_t = 0.0;
+}
+
+static void count_solve(island_ctx *c, lc_contact_solve s, int rows);
+
+/* Solves rows[0..m) from the velocities in b.v (their start) into b.v: Gauss-Seidel with momentum from
+ * the rows' warm start (contact_solver.c), at most contact_iterations sweeps, to contact_tolerance. In a
+ * precise retry (lc_contact_advance) a problem of at most LC_CONTACT_PRECISE_EXACT_POINTS points is
+ * solved exactly (contact_exact.c) and confirmed by sweeps from that answer, a larger one by up to
+ * LC_CONTACT_PRECISE_SWEEPS sweeps. Returns 0, or -1 without memory. */
+static int solve(island_ctx *c, lc_contact_row *rows, int m)
+{
+    lc_world *w = c->w;
+    lc_contact_solve s;
+    int sweeps = c->precise && w->def.contact_iterations < LC_CONTACT_PRECISE_SWEEPS ? LC_CONTACT_PRECISE_SWEEPS
+                                                                                     : w->def.contact_iterations;
+    if (c->precise && m > 0 && m <= LC_CONTACT_PRECISE_EXACT_POINTS) {
+        double *scratch = lc_buf_get(&c->cr->b_exact, lc_contact_exact_scratch(m) * sizeof(double));
+        double *vstart = lc_buf_get(&c->cr->b_vstart, (size_t)c->b.n * 3 * sizeof(double));
+        if (scratch == NULL || vstart == NULL) return -1;
+        memcpy(vstart, c->b.v, (size_t)c->b.n * 3 * sizeof(double));
+        /* the exact answer becomes the rows' start; b.v is rebuilt from it by the sweeps */
+        if (lc_contact_solve_exact(rows, m, c->b.v, c->b.inv_mass, c->b.inv_inertia, scratch) >= 0)
+            w->last.contact_exact_solves++;
+        memcpy(c->b.v, vstart, (size_t)c->b.n * 3 * sizeof(double));
+    }
+    s = lc_contact_solver_run(rows, m, c->b.v, c->b.inv_mass, c->b.inv_inertia, sweeps, w->def.contact_tolerance);
+    count_solve(c, s, m);
+    return 0;
+}
+
+static void count_solve(island_ctx *c, lc_contact_solve s, int rows)
+{
+    c->w->last.contact_sweeps += (uint64_t)s.sweeps;
+    c->w->last.contact_points += (uint64_t)rows;
+    if (s.residual > c->residual) c->residual = s.residual;
+}
+
+/* Step 2: impacts at the start of the sub-step. Changes b.v0. Returns the points that received an
+ * impulse, or -1. */
+static int impacts(island_ctx *c, lc_touch *t, int nt, double h)
+{
+    lc_world *w = c->w;
+    /* Any closed point that approaches is an impact: the trapezoidal update would otherwise have to turn
+     * its approach into an equal separation to keep the gap (an elastic micro-bounce that never
+     * dissipates; a pile at resting_speed 1e-2 kept bodies rocking at 2 mm/s that way). Approaches
+     * slower than contact_tolerance are the solves' own noise. Only approaches faster than
+     * resting_speed count and are reported as collisions. */
+    double gc = w->def.contact_gap, vmin = w->def.contact_tolerance;
+    double vr = w->def.resting_speed;
+    int real = 0, bounced = 0;
+    lc_contact_row *rows = lc_buf_get(&c->cr->b_irows, (size_t)(nt > 0 ? nt : 1) * sizeof(lc_contact_row));
+    int *which, i, m = 0, fast = 0, hits = 0;
+    if (rows == NULL) return -1;
+    which = (int *)lc_buf_get(&c->cr->b_hash, (size_t)(nt > 0 ? nt : 1) * sizeof(int));
+    if (which == NULL) return -1;
+    for (i = 0; i < nt; ++i) {
+        double un, ut;
+        int closed = t[i].gap < w->def.contact_distance;
+        make_row(c, &t[i], &rows[m]);
+        lc_contact_row_velocity(&rows[m], c->b.v0, &un, &ut);
+        /* a large island has no located arrivals: a point that would arrive in the first half of the
+         * step would need a bounce to keep its gap under the trapezoidal update, so it is an impact now */
+        if (!closed && !(!c->small && un < 0.0 && t[i].gap - gc < -0.5 * un * h)) continue;
+        t[i].vn_pre = un;
+        if (un < -vmin) fast = 1;
+        which[m++] = i;
+    }
+    if (!fast) return 0;
+    memcpy(c->b.v, c->b.v0, (size_t)c->b.n * 3 * sizeof(double));
+    if (solve(c, rows, m) != 0) return -1;
+    /* Poisson: e j_c more along the normal where the point's own approach was fast enough to bounce.
+     * Those impulses push the bodies into their other touches too (a box hit from above, resting on
+     * the floor), whose own e may be 0: a second compression stops every approach they start, as the
+     * first did, so the restitution comes out of the bounce and never from the floor (without it a
+     * block hit at 4 m/s was driven into the floor at 3 m/s and the step gained 2 J). */
+    for (i = 0; i < m; ++i) {
+        lc_touch *x = &t[which[i]];
+        lc_contact_row *r = &rows[i];
+        double e = x->vn_pre < -lc_bounce_speed(w, x->elasticity) ? x->elasticity : 0.0, extra;
+        x->value = x->tangent = 0.0;
+        if (!(r->lambda_n > 0.0)) continue;
+        extra = e * r->lambda_n;
+        if (extra > 0.0) {
+            lc_contact_row_apply(r, extra, 0.0, c->b.v, c->b.inv_mass, c->b.inv_inertia);
+            bounced = 1;
+        }
+        x->value = r->lambda_n + extra;
+        x->tangent = r->lambda_t;
+    }
+    if (bounced) {
+        for (i = 0; i < m; ++i) rows[i].lambda_n = rows[i].lambda_t = 0.0;
+        if (solve(c, rows, m) != 0) return -1;
+        for (i = 0; i < m; ++i) {
+            t[which[i]].value += rows[i].lambda_n;
+            t[which[i]].tangent += rows[i].lambda_t;
+        }
+    }
+    for (i = 0; i < m; ++i) {
+        lc_touch *x = &t[which[i]];
+        if (!(x->value > 0.0)) continue;
+        hits++;
+        if (x->vn_pre < -vr) {
+            real = 1;
+            w->last.impulses++;
+            if (lc_push_contact(w, x, LC_CONTACT_COLLISION) != 0) return -1;
+        }
+    }
+    memcpy(c->b.v0, c->b.v, (size_t)c->b.n * 3 * sizeof(double));
+    w->last.impulse_solves++;
+    if (real) w->last.collisions++;
+    return hits;
+}
+
+/* Touching points without a force from the last step start from the weight they carry at rest, shared down the
+ * "rests on" graph by the lever rule (static_load.c): a stack or pyramid created at rest, or a body
+ * landing on one, starts at its answer, where Gauss-Seidel from zero needs sweeps in the square of the
+ * stack's height (a 20-stack sagged and bounced for a second) and a 1000:1 mass ratio never gets there. */
+static int cold_start(island_ctx *c, const lc_touch *t, int nt, double h, lc_contact_row *rows)
+{
+    lc_world *w = c->w;
+    int i, m = 0, cold = 0;
+    lc_touch *closed;
+    int *which;
+    double *f;
+    for (i = 0; i < nt; ++i)
+        if (t[i].gap < w->def.contact_distance && rows[i].lambda_n == 0.0 && rows[i].lambda_t == 0.0) cold = 1;
+    if (!cold) return 0;
+    closed = lc_buf_get(&c->cr->b_cold, (size_t)nt * sizeof(lc_touch));
+    f = lc_buf_get(&c->cr->b_cold_load, (size_t)nt * (sizeof(double) + sizeof(int)));
+    if (closed == NULL || f == NULL) return -1;
+    which = (int *)(f + nt);
+    for (i = 0; i < nt; ++i)
+        if (t[i].gap < w->def.contact_distance) {
+            closed[m] = t[i];
+            which[m] = i;
+            f[m] = 0.0;
+            m++;
+        }
+    if (lc_static_load_forces_of(w, closed, m, c->local, c->isl->rows, c->b.n, f) != 0) return -1;
+    for (i = 0; i < m; ++i) {
+        lc_contact_row *r = &rows[which[i]];
+        if (r->lambda_n == 0.0 && r->lambda_t == 0.0 && f[i] > 0.0) r->lambda_n = f[i] * h;
+    }
+    return 0;
+}
+
+/* Step 3: the flow over h from b.v0 into b.v. */
+static int flow(island_ctx *c, const lc_touch *t, int nt, double h, lc_contact_row *rows)
+{
+    lc_world *w = c->w;
+    double gc = w->def.contact_gap;
+    int i, nb = c->b.n;
+    for (i = 0; i < nb * 3; ++i) c->b.v[i] = c->b.v0[i] + h * c->b.acc[i];
+    for (i = 0; i < nt; ++i) {
+        lc_contact_row *r = &rows[i];
+        double un, ut, fn, ft;
+        make_row(c, &t[i], r);
+        lc_contact_row_velocity(r, c->b.v0, &un, &ut);
+        r->target_n = -un - 2.0 * fmax(t[i].gap - gc, 0.0) / h;
+        r->slip = ut > LC_CONTACT_SLIP_SPEED ? 1 : ut < -LC_CONTACT_SLIP_SPEED ? -1 : 0;
+        if (lc_contact_cache_find(c->cr->cache, key_of(w, &t[i]), &fn, &ft)) {
+            r->lambda_n = fn * h;
+            r->lambda_t = ft * h;
+        }
+    }
+    if (cold_start(c, t, nt, h, rows) != 0) return -1;
+    return solve(c, rows, nt);
+}
+
+/* Step 4: the fraction of h at which the first located transition happens (1: none). Arrivals: a
+ * point not touching that approaches reaches the contact gap at (gap - contact_gap) / -u_n0. Stick:
+ * the points of a body pair that slipped at the start and stick at the end stopped when the friction
+ * impulse they used, at mu lambda_n per unit of time while slipping, ran out: at sum |lambda_t| /
+ * (mu sum lambda_n) of the step (exact for a body sliding to rest on a level surface; elsewhere the
+ * next sub-step refines it). */
+static double first_transition(const island_ctx *c, const lc_touch *t, const lc_contact_row *rows, int nt, double h)
+{
+    const lc_world *w = c->w;
+    double tau = 1.0, gc = w->def.contact_gap, vr = w->def.resting_speed;
+    int i;
+    for (i = 0; i < nt; ++i) {
+        double un, ut;
+        if (t[i].gap < w->def.contact_distance) continue;
+        lc_contact_row_velocity(&rows[i], c->b.v0, &un, &ut);
+        if (un < -vr) tau = fmin(tau, (t[i].gap - gc) / (-un * h));
+    }
+    i = 0;
+    while (i < nt) {
+        int j = i, any = 0;
+        double lt = 0.0, ln = 0.0, mu = rows[i].mu;
+        while (j < nt && ((t[j].a == t[i].a && t[j].b == t[i].b) || (t[j].a == t[i].b && t[j].b == t[i].a))) {
+            const lc_contact_row *r = &rows[j];
+            double un, ut;
+            lc_contact_row_velocity(r, c->b.v0, &un, &ut);
+            if (r->slip != 0 && r->lambda_n > 0.0 && fabs(ut) > vr) {
+                lt += fabs(r->lambda_t);
+                ln += r->lambda_n;
+                if (fabs(r->lambda_t) < r->mu * r->lambda_n * (1.0 - 1e-9)) any = 1;
+            }
+            ++j;
+        }
+        /* a stop at the very start: nothing to locate (the point barely slipped) */
+        if (any && mu > 0.0 && ln > 0.0 && lt > LC_CONTACT_CUT_EPSILON * mu * ln) tau = fmin(tau, lt / (mu * ln));
+        i = j;
+    }
+    return tau;
+}
+
+/* Step 5: positions by the trapezoidal rule; velocities become the solver's. */
+static void advance_positions(island_ctx *c, double h)
+{
+    lc_world *w = c->w;
+    int i, k;
+    for (i = 0; i < c->b.n; ++i) {
+        double *s = &w->state[c->isl->rows[i] * 6];
+        for (k = 0; k < 3; ++k) {
+            s[k] += 0.5 * h * (c->b.v0[i * 3 + k] + c->b.v[i * 3 + k]);
+            s[3 + k] = c->b.v[i * 3 + k];
+        }
+    }
+}
+
+/* Energy of the island's bodies at state (world rows, or the island's own rows when !world_rows):
+ * kinetic and gravitational; *kinetic gets the kinetic part, *size the sum of the terms' magnitudes
+ * (the scale of its round-off). */
+static double island_energy(const lc_world *w, const lc_island *isl, const double *state, int world_rows,
+                            double *kinetic, double *size)
+{
+    double e = 0.0, ke = 0.0, mag = 0.0;
+    int i;
+    for (i = 0; i < isl->nrows; ++i) {
+        int r = isl->rows[i];
+        const double *s = world_rows ? &state[r * 6] : &state[i * 6];
+        double k = 0.5 * w->mass[r] * (s[SVX] * s[SVX] + s[SVY] * s[SVY]) + 0.5 * w->inertia[r] * s[SW] * s[SW];
+        double p = -w->mass[r] * (w->def.gravity.x * s[SX] + w->def.gravity.y * s[SY]);
+        ke += k;
+        e += k + p;
+        mag += k + fabs(p);
+    }
+    *kinetic = ke;
+    *size = mag;
+    return e;
+}
+
+/* 1 if a force other than gravity and contacts can do work on the island: thrusters, external force or
+ * torque, springs. */
+static int island_driven(const island_ctx *c)
+{
+    const lc_world *w = c->w;
+    int i, k;
+    for (i = 0; i < c->isl->nrows; ++i)
+        if (lc_body_driven(w, c->isl->rows[i])) return 1;
+    for (k = 0; k < w->spring_count; ++k) {
+        int a = lc_world_body_index(w, w->springs[k].def.body_a);
+        int b = w->springs[k].def.body_b == LC_WORLD_ANCHOR ? -1 : lc_world_body_index(w, w->springs[k].def.body_b);
+        if ((a >= 0 && c->local[a] >= 0) || (b >= 0 && c->local[b] >= 0)) return 1;
+    }
+    return 0;
+}
+
+/* The projection by MPRGP (sparse_lcp.c, conjugate gradients with bound projections), when Gauss-Seidel
+ * did not converge: it needs sweeps in the square of a chain's length (a block pushing a row of twenty
+ * boxes left the row overlapping after 400), MPRGP products in its length. The displacements land in
+ * b.disp. */
+static int project_by_mprgp(island_ctx *c, const lc_touch *t, int nt, double gp, lc_contact_row *rows)
+{
+    lc_world *w = c->w;
+    double *v = lc_buf_get(&c->cr->b_mprgp, (size_t)nt * 4 * sizeof(double)), *b, *lo, *hi, viol;
+    int i;
+    if (v == NULL) return -1;
+    b = v + nt;
+    lo = b + nt;
+    hi = lo + nt;
+    for (i = 0; i < nt; ++i) {
+        v[i] = 0.0;
+        b[i] = t[i].gap - gp;
+        lo[i] = 0.0;
+        hi[i] = INFINITY;
+    }
+    if (lc_sparse_lcp(w, t, nt, 0, b, lo, hi, v, LC_CONTACT_PROJECTION_SLACK, LC_CONTACT_PROJECTION_PRODUCTS, &viol) < 0) return -1;
+    for (i = 0; i < nt; ++i)
+        if (v[i] > 0.0 && isfinite(v[i])) lc_contact_row_apply(&rows[i], v[i], 0.0, c->b.disp, c->b.inv_mass, c->b.inv_inertia);
+    return 0;
+}
+
+/* Step 6a: points that end overlapping are moved out, to a gap of LC_CONTACT_PROJECTION_GAP (never more
+ * than a thousandth of contact_gap), by the smallest mass-weighted displacement (a complementarity
+ * problem in positions, the solver with displacements for velocities). Only out of the overlap, not up
+ * to the contact gap: every metre of lift against gravity is energy the step did not have (a
+ * contact_gap of 1 mm made that 1e-5 J per body). The touches are searched again after each pass:
+ * pushing one pair apart can turn another into the other body. Leaves the touches at the final state
+ * in cr->b_end; returns their count, or -1; *left: the deepest overlap left after the last pass (m). */
+static int project(island_ctx *c, double *left)
+{
+    lc_world *w = c->w;
+    double gp = fmin(LC_CONTACT_PROJECTION_GAP, 1e-3 * w->def.contact_gap), reach = 0.0;
+    int pass, i, k, nt = 0;
+    for (pass = 0;; ++pass) {
+        lc_touch *t;
+        lc_contact_row *rows;
+        lc_contact_solve ps;
+        int any = 0;
+        /* the points within twice the deepest overlap too: pushing a pair apart by that much can push
+         * a neighbour in (a row of boxes), and a point the solve does not hold is one pass more each */
+        nt = collect(c, 0.0, &c->cr->b_end, 0, reach);
+        if (nt < 0) return -1;
+        t = (lc_touch *)c->cr->b_end.p;
+        *left = 0.0;
+        for (i = 0; i < nt; ++i)
+            if (t[i].gap < -LC_CONTACT_PROJECTION_SLACK) {
+                any = 1;
+                *left = fmax(*left, -t[i].gap);
+            }
+        if (reach < 2.0 * *left) {
+            reach = 2.0 * *left;
+            nt = collect(c, 0.0, &c->cr->b_end, 0, reach);
+            if (nt < 0) return -1;
+            t = (lc_touch *)c->cr->b_end.p;
+        }
+        if (!any || pass == LC_CONTACT_PROJECTION_PASSES) break;
+        rows = lc_buf_get(&c->cr->b_irows, (size_t)nt * sizeof(lc_contact_row));
+        if (rows == NULL) return -1;
+        w->last.position_projections++;
+        for (i = 0; i < nt; ++i) {
+            make_row(c, &t[i], &rows[i]);
+            rows[i].mu = 0.0;
+            rows[i].target_n = gp - t[i].gap;
+        }
+        memset(c->b.disp, 0, (size_t)c->b.n * 3 * sizeof(double));
+        ps = lc_contact_solver_run(rows, nt, c->b.disp, c->b.inv_mass, c->b.inv_inertia, LC_CONTACT_PROJECTION_SWEEPS,
+                                   LC_CONTACT_PROJECTION_SLACK);
+        /* a pass that cut the overlap a hundredfold is kept: the next pass starts from there */
+        if (ps.residual > LC_CONTACT_PROJECTION_SLACK && ps.residual > LC_CONTACT_PROJECTION_GAIN * *left) {
+            memset(c->b.disp, 0, (size_t)c->b.n * 3 * sizeof(double));
+            if (project_by_mprgp(c, t, nt, gp, rows) != 0) return -1;
+        }
+        for (i = 0; i < c->b.n; ++i) {
+            double *s = &w->state[c->isl->rows[i] * 6];
+            for (k = 0; k < 3; ++k) s[k] += c->b.disp[i * 3 + k];
+        }
+    }
+    return nt;
+}
+
+/* Step 6b: an island no force but gravity and contacts drives ends with at most the energy it began
+ * with (the flow and the impacts dissipate; the projection's lift and the rotation's nonlinearity may
+ * not); an excess is taken from the kinetic energy by scaling the velocities. Returns the part the
+ * kinetic energy could not pay (J, 0 when all was paid). */
+static double energy_guard(island_ctx *c, double e0, double size0)
+{
+    lc_world *w = c->w;
+    double ke, size1, e1 = island_energy(w, c->isl, w->state, 1, &ke, &size1), excess, f;
+    int i;
+    excess = e1 - e0;
+    /* round-off of the two sums: a few ulps of the larger sum of magnitudes */
+    if (!(excess > 64.0 * 2.2e-16 * fmax(size0, size1))) return 0.0;
+    w->last.energy_clamps++;
+    f = ke > excess ? sqrt((ke - excess) / ke) : 0.0;
+    for (i = 0; i < c->isl->nrows; ++i) {
+        double *s = &w->state[c->isl->rows[i] * 6];
+        s[SVX] *= f;
+        s[SVY] *= f;
+        s[SW] *= f;
+    }
+    return ke < excess ? excess - ke : 0.0;
+}
+
+/* The touches at the end, their forces from the last flow's rows (matched by vertex and edge), reported
+ * as resting contacts and kept for the next step's warm start; bodies on a pair with e < 1 are marked. */
+static int finish(island_ctx *c, lc_touch *end, int nend, const lc_touch *t, const lc_contact_row *rows, int nt,
+                  double h)
+{
+    lc_world *w = c->w;
+    int size = 1, i, *table;
+    while (size < 2 * nt) size *= 2;
+    table = lc_buf_get(&c->cr->b_hash, (size_t)size * sizeof(int));
+    if (table == NULL) return -1;
+    for (i = 0; i < size; ++i) table[i] = -1;
+    for (i = 0; i < nt; ++i) {
+        uint32_t k = ((uint32_t)t[i].a * 2654435761u ^ (uint32_t)t[i].vertex * 40503u ^ (uint32_t)t[i].b * 97u ^
+                      (uint32_t)t[i].edge) & (uint32_t)(size - 1);
+        while (table[k] >= 0) k = (k + 1) & (uint32_t)(size - 1);
+        table[k] = i;
+    }
+    for (i = 0; i < nend; ++i) {
+        lc_touch *x = &end[i];
+        if (!(x->gap < w->def.contact_distance)) continue;   /* held near by the projection only */
+        uint32_t k = ((uint32_t)x->a * 2654435761u ^ (uint32_t)x->vertex * 40503u ^ (uint32_t)x->b * 97u ^
+                      (uint32_t)x->edge) & (uint32_t)(size - 1);
+        double fn = 0.0, ft = 0.0;
+        while (table[k] >= 0) {
+            const lc_touch *y = &t[table[k]];
+            if (y->a == x->a && y->b == x->b && y->vertex == x->vertex && y->edge == x->edge) {
+                fn = rows[table[k]].lambda_n / h;
+                ft = rows[table[k]].lambda_t / h;
+                break;
+            }
+            k = (k + 1) & (uint32_t)(size - 1);
+        }
+        x->value = fn;
+        x->tangent = ft;
+        if (x->elasticity < 1.0) w->rests_dissipative[x->a] = w->rests_dissipative[x->b] = 1;
+        if (lc_push_contact(w, x, LC_CONTACT_RESTING) != 0) return -1;
+        if (fn > 0.0 && lc_contact_cache_store(c->cr->cache, key_of(w, x), fn, ft) != 0) return -1;
+    }
+    for (i = 0; i < nend; ++i)
+        if (end[i].gap < w->def.contact_distance) w->last.resting_contacts++;
+    return 0;
+}
+
+/* Steps 1-6 over dt from the island's current state. Returns 0, -1 without memory, or -3 (see
+ * lc_contact_advance); on 0 the touches at the end are in cr->b_end (*nend), the last flow's touches
+ * and rows in cr->b_touch and cr->b_rows (*nt, *h_last). */
+static int advance(island_ctx *c, double dt, int driven, double e0, double size0, int *nend, int *nt, double *h_last)
+{
+    lc_world *w = c->w;
+    lc_contact_regime *cr = c->cr;
+    const lc_island *isl = c->isl;
+    double left = dt, h = dt, overlap = 0.0;
+    int i, cuts = 0;
+    lc_touch *t;
+    lc_contact_row *rows;
+    *nt = 0;
+    while (left > 0.0) {
+        double tau;
+        h = left;
+        if (applied(c) != 0) return -1;
+        *nt = collect(c, h, &cr->b_touch, 1, 0.0);
+        if (*nt < 0) return -1;
+        t = (lc_touch *)cr->b_touch.p;
+        rows = lc_buf_get(&cr->b_rows, (size_t)(*nt > 0 ? *nt : 1) * sizeof(lc_contact_row));
+        if (rows == NULL) return -1;
+        for (i = 0; i < isl->nrows; ++i) memcpy(&c->b.v0[i * 3], &w->state[isl->rows[i] * 6 + 3], 3 * sizeof(double));
+        if (impacts(c, t, *nt, h) < 0 || flow(c, t, *nt, h, rows) != 0) return -1;
+        tau = c->small && cuts < LC_CONTACT_MAX_CUTS ? first_transition(c, t, rows, *nt, h) : 1.0;
+        if (tau < 1.0 - LC_CONTACT_CUT_EPSILON) {
+            /* solved again over the part of the step before the transition */
+            h = tau * left;
+            if (flow(c, t, *nt, h, rows) != 0) return -1;
+            cuts++;
+            w->last.contact_cuts++;
+        }
+        advance_positions(c, h);
+        left = h < left ? left - h : 0.0;
+        if (left < 1e-14 * dt) left = 0.0;
+    }
+    *h_last = h;
+    /* the touches at the end: projection, results, warm start */
+    *nend = project(c, &overlap);
+    if (*nend < 0) return -1;
+    /* bodies the projection cannot separate (wedged deep into a corner within one step), or an energy
+     * gain the island's kinetic energy cannot pay for */
+    c->overlap = overlap;
+    c->unpaid = driven ? 0.0 : energy_guard(c, e0, size0);
+    if (overlap > LC_CONTACT_OVERLAP_LEFT || c->unpaid > LC_CONTACT_ENERGY_LEFT * size0) return -3;
+    return 0;
+}
+
+int lc_contact_advance(lc_world *w, lc_contact_regime *cr, const lc_island *isl, double dt)
+{
+    island_ctx c;
+    double e0 = 0.0, ke0 = 0.0, size0 = 0.0, h = dt;
+    int i, k, nt = 0, nend = 0, driven, status, ncontacts = w->contact_count;
+    double *start;
+    memset(&c, 0, sizeof c);
+    c.w = w;
+    c.cr = cr;
+    c.isl = isl;
+    c.small = isl->nrows <= LC_CONTACT_LOCATE_MAX_BODIES;
+    if (map_island(&c) != 0) return -1;
+    w->last.contact_islands++;
+    start = lc_buf_get(&cr->b_start, (size_t)(isl->nrows > 0 ? isl->nrows : 1) * 6 * sizeof(double));
+    if (start == NULL) goto oom;
+    for (i = 0; i < isl->nrows; ++i) {
+        memcpy(&start[i * 6], &w->state[isl->rows[i] * 6], 6 * sizeof(double));
+        w->rests_dissipative[isl->rows[i]] = 0;
+    }
+    driven = island_driven(&c);
+    e0 = island_energy(w, isl, start, 0, &ke0, &size0);
+    status = advance(&c, dt, driven, e0, size0, &nend, &nt, &h);
+    if (status == -3) {
+        /* once more with every solve run to convergence (solve()): a nearly resting island whose solve
+         * stopped at contact_iterations can end overlapping or with a gain its kinetic energy cannot pay */
+        w->last.contact_precise_retries++;
+        for (i = 0; i < isl->nrows; ++i) memcpy(&w->state[isl->rows[i] * 6], &start[i * 6], 6 * sizeof(double));
+        w->contact_count = ncontacts;
+        c.precise = 1;
+        status = advance(&c, dt, driven, e0, size0, &nend, &nt, &h);
+    }
+    if (status == -3 && isl->nrows > LC_CONTACT_EVENT_FALLBACK_BODIES) {
+        w->last.contact_unresolved++;
+        if (c.overlap > w->last.max_unresolved_overlap) w->last.max_unresolved_overlap = c.overlap;
+        if (c.unpaid > w->last.max_unresolved_energy) w->last.max_unresolved_energy = c.unpaid;
+        status = 0;
+    }
+    if (status == -1) goto oom;
+    for (i = 0; i < isl->nrows && status == 0; ++i)
+        for (k = 0; k < 6; ++k)
+            if (!isfinite(w->state[isl->rows[i] * 6 + k])) status = -2;
+    if (status == 0 &&
+        finish(&c, (lc_touch *)cr->b_end.p, nend, (lc_touch *)cr->b_touch.p, (lc_contact_row *)cr->b_rows.p, nt, h) != 0)
+        goto oom;
+    if (c.residual > w->last.max_contact_residual) w->last.max_contact_residual = c.residual;
+    unmap_island(&c);
+    return status;
+oom:
+    unmap_island(&c);
+    return -1;
+}

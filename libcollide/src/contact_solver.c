@@ -1,0 +1,247 @@
+/* Nonsmooth Gauss-Seidel on contact impulses (see contact_solver.h for the problem and the stopping
+ * rule). */
+#include <math.h>
+#include "contact_solver.h"
+#include "tunables.h"
+
+static double row_mass(const lc_contact_row *r, double rla, double rlb, const double *inv_mass,
+                       const double *inv_inertia)
+{
+    double k = 0.0;
+    if (r->a >= 0) k += inv_mass[r->a] + rla * rla * inv_inertia[r->a];
+    if (r->b >= 0) k += inv_mass[r->b] + rlb * rlb * inv_inertia[r->b];
+    return k > 0.0 ? 1.0 / k : 0.0;
+}
+
+void lc_contact_row_velocity(const lc_contact_row *r, const double *v, double *un, double *ut)
+{
+    double n = 0.0, t = 0.0;
+    if (r->a >= 0) {
+        const double *x = &v[r->a * 3];
+        n += r->nx * x[0] + r->ny * x[1] + r->rna * x[2];
+        t += -r->ny * x[0] + r->nx * x[1] + r->rta * x[2];
+    }
+    if (r->b >= 0) {
+        const double *x = &v[r->b * 3];
+        n -= r->nx * x[0] + r->ny * x[1] + r->rnb * x[2];
+        t -= -r->ny * x[0] + r->nx * x[1] + r->rtb * x[2];
+    }
+    *un = n;
+    *ut = t;
+}
+
+void lc_contact_row_apply(const lc_contact_row *r, double dn, double dt, double *v, const double *inv_mass,
+                  const double *inv_inertia)
+{
+    double px = dn * r->nx - dt * r->ny, py = dn * r->ny + dt * r->nx;
+    if (r->a >= 0) {
+        double *x = &v[r->a * 3];
+        x[0] += px * inv_mass[r->a];
+        x[1] += py * inv_mass[r->a];
+        x[2] += (dn * r->rna + dt * r->rta) * inv_inertia[r->a];
+    }
+    if (r->b >= 0) {
+        double *x = &v[r->b * 3];
+        x[0] -= px * inv_mass[r->b];
+        x[1] -= py * inv_mass[r->b];
+        x[2] -= (dn * r->rnb + dt * r->rtb) * inv_inertia[r->b];
+    }
+}
+
+static void friction_bounds(const lc_contact_row *r, double *lo, double *hi)
+{
+    double c = r->mu * r->lambda_n;
+    *lo = r->slip > 0 ? -c : r->slip < 0 ? 0.0 : -c;
+    *hi = r->slip > 0 ? 0.0 : c;
+}
+
+/* The off-diagonal entry of A = J M^-1 J^T between the normal rows of two points of one body pair. */
+static double coupling(const lc_contact_row *r, const lc_contact_row *q, const double *inv_mass,
+                       const double *inv_inertia)
+{
+    double k = 0.0, nn = r->nx * q->nx + r->ny * q->ny;
+    if (r->a >= 0) k += inv_mass[r->a] * nn + inv_inertia[r->a] * r->rna * q->rna;
+    if (r->b >= 0) k += inv_mass[r->b] * nn + inv_inertia[r->b] * r->rnb * q->rnb;
+    return k;
+}
+
+/* Rows i and i + 1 are the two points of one body pair (a box face on another's): their normal rows are
+ * solved together, exactly (the 2 x 2 complementarity problem by its four active sets). Gauss-Seidel
+ * row by row converges at the square of their coupling through the pair's rotation (a flat box on the
+ * floor: ~0.17 a sweep), so a stack of n boxes needed ~n^2 sweeps; the block removes that factor. */
+static void prepare_block(lc_contact_row *r, const double *inv_mass, const double *inv_inertia)
+{
+    lc_contact_row *q = r + 1;
+    double k11, k22, k12, det;
+    r->block = 0;
+    if (r->a != q->a || r->b != q->b || !(r->mass_n > 0.0) || !(q->mass_n > 0.0)) return;
+    k11 = 1.0 / r->mass_n;
+    k22 = 1.0 / q->mass_n;
+    k12 = coupling(r, q, inv_mass, inv_inertia);
+    det = k11 * k22 - k12 * k12;
+    /* nearly dependent rows (two points at one place): row by row */
+    if (!(det > 1e-9 * k11 * k22)) return;
+    r->block = 1;
+    r->k12 = k12;
+    r->det = det;
+}
+
+/* The block's normal impulses; returns the largest change in velocity units. */
+static double solve_block(lc_contact_row *r, double *v, const double *inv_mass, const double *inv_inertia)
+{
+    lc_contact_row *q = r + 1;
+    double u1, u2, t1, t2, k11 = 1.0 / r->mass_n, k22 = 1.0 / q->mass_n, k12 = r->k12, b1, b2, x1, x2, d1, d2;
+    lc_contact_row_velocity(r, v, &u1, &t1);
+    lc_contact_row_velocity(q, v, &u2, &t2);
+    /* u' - target = K x + b for new impulses x */
+    b1 = u1 - r->target_n - (k11 * r->lambda_n + k12 * q->lambda_n);
+    b2 = u2 - q->target_n - (k12 * r->lambda_n + k22 * q->lambda_n);
+    x1 = (-b1 * k22 + b2 * k12) / r->det;
+    x2 = (-b2 * k11 + b1 * k12) / r->det;
+    if (!(x1 >= 0.0 && x2 >= 0.0)) {
+        x1 = -b1 / k11;
+        x2 = 0.0;
+        if (!(x1 >= 0.0 && k12 * x1 + b2 >= 0.0)) {
+            x1 = 0.0;
+            x2 = -b2 / k22;
+            if (!(x2 >= 0.0 && k12 * x2 + b1 >= 0.0)) {
+                x2 = 0.0;
+                if (!(b1 >= 0.0 && b2 >= 0.0)) {
+                    /* no active set fits (round-off at a degenerate corner): one Gauss-Seidel pass */
+                    x1 = r->lambda_n + r->mass_n * (r->target_n - u1);
+                    x1 = x1 > 0.0 ? x1 : 0.0;
+                    x2 = q->lambda_n + q->mass_n * (q->target_n - u2 - k12 * (x1 - r->lambda_n));
+                    x2 = x2 > 0.0 ? x2 : 0.0;
+                }
+            }
+        }
+    }
+    d1 = x1 - r->lambda_n;
+    d2 = x2 - q->lambda_n;
+    r->lambda_n = x1;
+    q->lambda_n = x2;
+    if (d1 != 0.0) lc_contact_row_apply(r, d1, 0.0, v, inv_mass, inv_inertia);
+    if (d2 != 0.0) lc_contact_row_apply(q, d2, 0.0, v, inv_mass, inv_inertia);
+    return fmax(fabs(d1) * k11, fabs(d2) * k22);
+}
+
+/* A normal row alone; returns its change in velocity units. */
+static double solve_normal(lc_contact_row *r, double *v, const double *inv_mass, const double *inv_inertia)
+{
+    double un, ut, ln, dn;
+    lc_contact_row_velocity(r, v, &un, &ut);
+    ln = r->lambda_n + r->mass_n * (r->target_n - un);
+    if (!(ln > 0.0)) ln = 0.0;
+    dn = ln - r->lambda_n;
+    r->lambda_n = ln;
+    if (dn == 0.0) return 0.0;
+    lc_contact_row_apply(r, dn, 0.0, v, inv_mass, inv_inertia);
+    return r->mass_n > 0.0 ? fabs(dn) / r->mass_n : 0.0;
+}
+
+/* A friction row, in the cone of its current normal impulse; returns its change in velocity units. */
+static double solve_friction(lc_contact_row *r, double *v, const double *inv_mass, const double *inv_inertia)
+{
+    double un, ut, lt, lo, hi, dt;
+    if (!(r->mu > 0.0) && r->lambda_t == 0.0) return 0.0;
+    lc_contact_row_velocity(r, v, &un, &ut);
+    friction_bounds(r, &lo, &hi);
+    lt = r->lambda_t - r->mass_t * ut;
+    lt = lt < lo ? lo : lt > hi ? hi : lt;
+    dt = lt - r->lambda_t;
+    r->lambda_t = lt;
+    if (dt == 0.0) return 0.0;
+    lc_contact_row_apply(r, 0.0, dt, v, inv_mass, inv_inertia);
+    return r->mass_t > 0.0 ? fabs(dt) / r->mass_t : 0.0;
+}
+
+/* One Gauss-Seidel sweep over the rows; returns its largest change in velocity units. */
+static double sweep(lc_contact_row *rows, int nrows, double *v, const double *inv_mass, const double *inv_inertia)
+{
+    double change = 0.0;
+    int i;
+    for (i = 0; i < nrows; ++i) {
+        lc_contact_row *r = &rows[i];
+        if (r->block) {
+            change = fmax(change, solve_block(r, v, inv_mass, inv_inertia));
+            change = fmax(change, solve_friction(r, v, inv_mass, inv_inertia));
+            change = fmax(change, solve_friction(r + 1, v, inv_mass, inv_inertia));
+            ++i;
+        } else {
+            change = fmax(change, solve_normal(r, v, inv_mass, inv_inertia));
+            change = fmax(change, solve_friction(r, v, inv_mass, inv_inertia));
+        }
+    }
+    return change;
+}
+
+lc_contact_solve lc_contact_solver_run(lc_contact_row *rows, int nrows, double *v, const double *inv_mass,
+                                       const double *inv_inertia, int max_sweeps, double tolerance)
+{
+    lc_contact_solve out;
+    double checkpoint = INFINITY, rr_old = 0.0;
+    int i, s;
+    out.sweeps = 0;
+    out.residual = 0.0;
+    for (i = 0; i < nrows; ++i) {
+        lc_contact_row *r = &rows[i];
+        double lo, hi;
+        r->mass_n = row_mass(r, r->rna, r->rnb, inv_mass, inv_inertia);
+        r->mass_t = row_mass(r, r->rta, r->rtb, inv_mass, inv_inertia);
+        r->block = 0;
+        if (!(isfinite(r->lambda_n) && r->lambda_n > 0.0)) r->lambda_n = 0.0;
+        if (!isfinite(r->lambda_t)) r->lambda_t = 0.0;
+        friction_bounds(r, &lo, &hi);
+        r->lambda_t = r->lambda_t < lo ? lo : r->lambda_t > hi ? hi : r->lambda_t;
+        if (r->lambda_n != 0.0 || r->lambda_t != 0.0) lc_contact_row_apply(r, r->lambda_n, r->lambda_t, v, inv_mass, inv_inertia);
+        r->prev_n = r->lambda_n;
+        r->prev_t = r->lambda_t;
+        r->dir_n = r->dir_t = 0.0;
+    }
+    for (i = 0; i + 1 < nrows; ++i) {
+        prepare_block(&rows[i], inv_mass, inv_inertia);
+        if (rows[i].block) ++i;
+    }
+    for (s = 0; s < max_sweeps; ++s) {
+        double change, rr = 0.0, beta;
+        if (s > 0 && s % LC_CONTACT_STALL_SWEEPS == 0) {
+            /* Gauss-Seidel on frictional rows can crawl at a ratio near 1 (two bodies whose points'
+             * friction and normal impulses trade through their rotation): a solve whose largest
+             * change has not halved in that many sweeps stops and reports it */
+            if (!(out.residual < 0.5 * checkpoint)) break;
+            checkpoint = out.residual;
+        }
+        change = sweep(rows, nrows, v, inv_mass, inv_inertia);
+        out.sweeps = s + 1;
+        out.residual = change;
+        if (change <= tolerance) break;
+        /* Nonsmooth nonlinear conjugate gradients (Silcowitz, Niebe and Erleben 2010): the sweep's
+         * step r = lambda - lambda_prev is a descent direction; adding beta times the last direction,
+         * beta = |r|^2 / |r_old|^2 (Fletcher-Reeves, restarted when it exceeds 1), carries a stack's
+         * slowly converging modes along, where Gauss-Seidel alone takes sweeps in the square of its
+         * height. The next sweep projects back onto the cone. */
+        for (i = 0; i < nrows; ++i) {
+            double dn = rows[i].lambda_n - rows[i].prev_n, dt = rows[i].lambda_t - rows[i].prev_t;
+            rr += dn * dn + dt * dt;
+        }
+        beta = rr_old > 0.0 ? rr / rr_old : 0.0;
+        if (beta > 1.0) beta = 0.0;
+        for (i = 0; i < nrows; ++i) {
+            lc_contact_row *r = &rows[i];
+            double dn = r->lambda_n - r->prev_n, dt = r->lambda_t - r->prev_t;
+            r->dir_n = beta * r->dir_n + dn;
+            r->dir_t = beta * r->dir_t + dt;
+            if (beta > 0.0) {
+                double an = beta * (r->dir_n - dn), at = beta * (r->dir_t - dt);
+                /* the momentum beta * p_old, applied to the impulses and the velocities */
+                r->lambda_n += an;
+                r->lambda_t += at;
+                if (an != 0.0 || at != 0.0) lc_contact_row_apply(r, an, at, v, inv_mass, inv_inertia);
+            }
+            r->prev_n = r->lambda_n;
+            r->prev_t = r->lambda_t;
+        }
+        rr_old = rr;
+    }
+    return out;
+}

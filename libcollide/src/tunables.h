@@ -1,0 +1,87 @@
+/* The engine's fixed tunables, with why each is what it is. Settings a user may change are in
+ * lc_world_def (types.h); these are not meant to be changed. */
+#ifndef LC_TUNABLES_H
+#define LC_TUNABLES_H
+
+/* ---- the step (step.c) ----------------------------------------------------------------------- */
+
+/* Tries of one step: after each, bodies whose actual paths met a body their island's build did not
+ * pair them with (an impact threw one off its predicted path) get their islands grown to where they
+ * went, and the step is taken again. Rare; the last try is kept. */
+#define LC_MAX_ISLAND_TRIES 4
+
+/* Impacts of pairs that are not perfectly elastic the event regime resolves in one step before it hands
+ * the island of the last one to the contact regime: a block bouncing ever lower at e < 1 makes
+ * impacts without end when no speed threshold stops them (restitution_threshold and resting_speed
+ * both 0), the inelastic collapse the contact regime exists for. A settling block makes a handful. */
+#define LC_HANDOVER_EVENTS 8
+
+/* ---- the contact regime (contact_regime.c) ---------------------------------------------------- */
+
+/* Islands of at most this many bodies (a body on static ones) have their stick-slip transitions and
+ * the arrivals of new contacts located in time (the step is cut there and solved again), as the event
+ * regime locates impacts: a block sliding to a stop or into a wall is where a user sees the difference
+ * (the stop distance v^2 / (2 mu g) exact instead of ~1e-3 off at dt 1/60). A cut costs one or two
+ * solves of the island; in a pile transitions happen at every contact at different times, and cutting
+ * at each (islands of up to 4 bodies: 10-30 cuts a step while 30 boxes settle) multiplied the step's
+ * cost without a visible difference. */
+#define LC_CONTACT_LOCATE_MAX_BODIES 1
+/* Most cuts in one island's step; beyond them the rest of the step is taken whole. A rocking block
+ * makes a few transitions per step; the cap bounds a pathological chatter. */
+#define LC_CONTACT_MAX_CUTS 8
+/* A transition within this fraction of the step's end is left to the next step. */
+#define LC_CONTACT_CUT_EPSILON 1e-9
+/* m/s: a point that slips faster than this when a step begins gets friction only against its slip
+ * (contact_solver.h), which keeps the friction's work over the step <= 0; slower, the whole cone
+ * (static friction must hold a body at rest whose slip is round-off of either sign, ~1e-12 m/s). The
+ * cone's work on such a point is at most mu lambda_n times this: 1e-9 J for a 1 kg body at dt 1/60
+ * (resting_speed, 1e-4 m/s by default and up to 10, made it up to 7e-5 J in one step of a pile). */
+#define LC_CONTACT_SLIP_SPEED 1e-6
+/* When a contact-regime step ends with an overlap it cannot project away or an energy gain the island's
+ * kinetic energy cannot pay (a nearly resting island whose solves stopped at contact_iterations, 1e-4
+ * to 5e-3 m/s off), the step is taken again with solves of up to this many sweeps and exact ones up to
+ * this many points (a 16-point problem: ~40 pivots, where the sweeps need 100-700). */
+#define LC_CONTACT_PRECISE_SWEEPS 1000
+#define LC_CONTACT_PRECISE_EXACT_POINTS 32
+/* Islands of at most this many bodies whose contact-regime step, precise too, leaves an overlap or an
+ * energy gain above the allowances below are taken again in the event regime, exact at that size. A
+ * larger island keeps the precise step and counts it (lc_counters contact_unresolved): the event
+ * regime's cost grows with the cube of an island's contacts at each micro-impact (a base-12 pyramid
+ * hit by a box: seconds for one step), and the gain such a step keeps is what its stalled solve left,
+ * ~1e-7 of the island's energy in that pyramid. */
+#define LC_CONTACT_EVENT_FALLBACK_BODIES 8
+/* Sweeps over which a contact solve's largest change must halve, or the solve stops as stalled. */
+#ifndef LC_CONTACT_STALL_SWEEPS   /* -D to measure */
+#define LC_CONTACT_STALL_SWEEPS 32
+#endif
+/* m, the gap the position projection moves an overlapping point out to (and the overlap that starts
+ * it): a tenth of the 1e-9 m overlap the test suites allow at a step's end, far below what a lift
+ * costs in energy (1e-9 J per kg). contact_gap / 1000 where that is smaller. */
+#define LC_CONTACT_PROJECTION_GAP 1e-10
+/* m, how far from that aim the projection's solve may stop, and the overlap that starts it: it then
+ * leaves at most this (to first order; the passes catch the rest) of the 1e-9 m allowed. Solving a
+ * pile's micrometre correction to 1e-11 m instead took MPRGP hundreds of products every step. */
+#ifndef LC_CONTACT_PROJECTION_SLACK
+#define LC_CONTACT_PROJECTION_SLACK 4e-10
+#endif
+/* m, the overlap a contact-regime step may leave after its projection before the island is taken again
+ * in the event regime: the test suites' 1e-9 m, ten times the projection's own aim. */
+#define LC_CONTACT_OVERLAP_LEFT 1e-9
+/* The energy gain, relative to an island's energy (the sum of its terms' magnitudes), a contact-regime
+ * step may leave when the island's kinetic energy cannot pay for it before the island is taken again
+ * in the event regime: ten times below the 1e-9 of a step's total energy that the contact scenes are
+ * held to (bench/contact.py), far above round-off (1e-14). */
+#define LC_CONTACT_ENERGY_LEFT 1e-10
+/* Passes of the position projection: each solves the linearised gaps, the nonlinear remainder of a
+ * rotation is second order and vanishes in a few. */
+#define LC_CONTACT_PROJECTION_PASSES 8
+/* Sweeps of each projection pass's Gauss-Seidel; when they do not converge, the pass is solved by MPRGP
+ * with at most LC_CONTACT_PROJECTION_PRODUCTS products of the response (a chain or stack of n bodies
+ * needs ~n^2 sweeps, ~n products). */
+#define LC_CONTACT_PROJECTION_SWEEPS 50
+#ifndef LC_CONTACT_PROJECTION_GAIN
+#define LC_CONTACT_PROJECTION_GAIN 1e-2
+#endif
+#define LC_CONTACT_PROJECTION_PRODUCTS 2000
+
+#endif
