@@ -13,7 +13,8 @@ static double row_mass(const lc_contact_row *r, double rla, double rlb, const do
     return k > 0.0 ? 1.0 / k : 0.0;
 }
 
-void lc_contact_row_velocity(const lc_contact_row *r, const double *v, double *un, double *ut)
+/* The sweeps' inner operations, inlined there (the exported forms below wrap them). */
+static inline void row_velocity(const lc_contact_row *r, const double *v, double *un, double *ut)
 {
     double n = 0.0, t = 0.0;
     if (r->a >= 0) {
@@ -30,8 +31,8 @@ void lc_contact_row_velocity(const lc_contact_row *r, const double *v, double *u
     *ut = t;
 }
 
-void lc_contact_row_apply(const lc_contact_row *r, double dn, double dt, double *v, const double *inv_mass,
-                  const double *inv_inertia)
+static inline void row_apply(const lc_contact_row *r, double dn, double dt, double *v, const double *inv_mass,
+                             const double *inv_inertia)
 {
     double px = dn * r->nx - dt * r->ny, py = dn * r->ny + dt * r->nx;
     if (r->a >= 0) {
@@ -48,7 +49,20 @@ void lc_contact_row_apply(const lc_contact_row *r, double dn, double dt, double 
     }
 }
 
-static void friction_bounds(const lc_contact_row *r, double *lo, double *hi)
+static inline double larger(double a, double b) { return b > a ? b : a; }
+
+void lc_contact_row_velocity(const lc_contact_row *r, const double *v, double *un, double *ut)
+{
+    row_velocity(r, v, un, ut);
+}
+
+void lc_contact_row_apply(const lc_contact_row *r, double dn, double dt, double *v, const double *inv_mass,
+                          const double *inv_inertia)
+{
+    row_apply(r, dn, dt, v, inv_mass, inv_inertia);
+}
+
+static inline void friction_bounds(const lc_contact_row *r, double *lo, double *hi)
 {
     double c = r->mu * r->lambda_n;
     *lo = r->slip > 0 ? -c : r->slip < 0 ? 0.0 : -c;
@@ -87,12 +101,12 @@ static void prepare_block(lc_contact_row *r, const double *inv_mass, const doubl
 }
 
 /* The block's normal impulses; returns the largest change in velocity units. */
-static double solve_block(lc_contact_row *r, double *v, const double *inv_mass, const double *inv_inertia)
+static inline double solve_block(lc_contact_row *r, double *v, const double *inv_mass, const double *inv_inertia)
 {
     lc_contact_row *q = r + 1;
     double u1, u2, t1, t2, k11 = 1.0 / r->mass_n, k22 = 1.0 / q->mass_n, k12 = r->k12, b1, b2, x1, x2, d1, d2;
-    lc_contact_row_velocity(r, v, &u1, &t1);
-    lc_contact_row_velocity(q, v, &u2, &t2);
+    row_velocity(r, v, &u1, &t1);
+    row_velocity(q, v, &u2, &t2);
     /* u' - target = K x + b for new impulses x */
     b1 = u1 - r->target_n - (k11 * r->lambda_n + k12 * q->lambda_n);
     b2 = u2 - q->target_n - (k12 * r->lambda_n + k22 * q->lambda_n);
@@ -120,38 +134,38 @@ static double solve_block(lc_contact_row *r, double *v, const double *inv_mass, 
     d2 = x2 - q->lambda_n;
     r->lambda_n = x1;
     q->lambda_n = x2;
-    if (d1 != 0.0) lc_contact_row_apply(r, d1, 0.0, v, inv_mass, inv_inertia);
-    if (d2 != 0.0) lc_contact_row_apply(q, d2, 0.0, v, inv_mass, inv_inertia);
-    return fmax(fabs(d1) * k11, fabs(d2) * k22);
+    if (d1 != 0.0) row_apply(r, d1, 0.0, v, inv_mass, inv_inertia);
+    if (d2 != 0.0) row_apply(q, d2, 0.0, v, inv_mass, inv_inertia);
+    return larger(fabs(d1) * k11, fabs(d2) * k22);
 }
 
 /* A normal row alone; returns its change in velocity units. */
-static double solve_normal(lc_contact_row *r, double *v, const double *inv_mass, const double *inv_inertia)
+static inline double solve_normal(lc_contact_row *r, double *v, const double *inv_mass, const double *inv_inertia)
 {
     double un, ut, ln, dn;
-    lc_contact_row_velocity(r, v, &un, &ut);
+    row_velocity(r, v, &un, &ut);
     ln = r->lambda_n + r->mass_n * (r->target_n - un);
     if (!(ln > 0.0)) ln = 0.0;
     dn = ln - r->lambda_n;
     r->lambda_n = ln;
     if (dn == 0.0) return 0.0;
-    lc_contact_row_apply(r, dn, 0.0, v, inv_mass, inv_inertia);
+    row_apply(r, dn, 0.0, v, inv_mass, inv_inertia);
     return r->mass_n > 0.0 ? fabs(dn) / r->mass_n : 0.0;
 }
 
 /* A friction row, in the cone of its current normal impulse; returns its change in velocity units. */
-static double solve_friction(lc_contact_row *r, double *v, const double *inv_mass, const double *inv_inertia)
+static inline double solve_friction(lc_contact_row *r, double *v, const double *inv_mass, const double *inv_inertia)
 {
     double un, ut, lt, lo, hi, dt;
     if (!(r->mu > 0.0) && r->lambda_t == 0.0) return 0.0;
-    lc_contact_row_velocity(r, v, &un, &ut);
+    row_velocity(r, v, &un, &ut);
     friction_bounds(r, &lo, &hi);
     lt = r->lambda_t - r->mass_t * ut;
     lt = lt < lo ? lo : lt > hi ? hi : lt;
     dt = lt - r->lambda_t;
     r->lambda_t = lt;
     if (dt == 0.0) return 0.0;
-    lc_contact_row_apply(r, 0.0, dt, v, inv_mass, inv_inertia);
+    row_apply(r, 0.0, dt, v, inv_mass, inv_inertia);
     return r->mass_t > 0.0 ? fabs(dt) / r->mass_t : 0.0;
 }
 
@@ -163,13 +177,13 @@ static double sweep(lc_contact_row *rows, int nrows, double *v, const double *in
     for (i = 0; i < nrows; ++i) {
         lc_contact_row *r = &rows[i];
         if (r->block) {
-            change = fmax(change, solve_block(r, v, inv_mass, inv_inertia));
-            change = fmax(change, solve_friction(r, v, inv_mass, inv_inertia));
-            change = fmax(change, solve_friction(r + 1, v, inv_mass, inv_inertia));
+            change = larger(change, solve_block(r, v, inv_mass, inv_inertia));
+            change = larger(change, solve_friction(r, v, inv_mass, inv_inertia));
+            change = larger(change, solve_friction(r + 1, v, inv_mass, inv_inertia));
             ++i;
         } else {
-            change = fmax(change, solve_normal(r, v, inv_mass, inv_inertia));
-            change = fmax(change, solve_friction(r, v, inv_mass, inv_inertia));
+            change = larger(change, solve_normal(r, v, inv_mass, inv_inertia));
+            change = larger(change, solve_friction(r, v, inv_mass, inv_inertia));
         }
     }
     return change;
@@ -193,7 +207,7 @@ lc_contact_solve lc_contact_solver_run(lc_contact_row *rows, int nrows, double *
         if (!isfinite(r->lambda_t)) r->lambda_t = 0.0;
         friction_bounds(r, &lo, &hi);
         r->lambda_t = r->lambda_t < lo ? lo : r->lambda_t > hi ? hi : r->lambda_t;
-        if (r->lambda_n != 0.0 || r->lambda_t != 0.0) lc_contact_row_apply(r, r->lambda_n, r->lambda_t, v, inv_mass, inv_inertia);
+        if (r->lambda_n != 0.0 || r->lambda_t != 0.0) row_apply(r, r->lambda_n, r->lambda_t, v, inv_mass, inv_inertia);
         r->prev_n = r->lambda_n;
         r->prev_t = r->lambda_t;
         r->dir_n = r->dir_t = 0.0;
@@ -236,7 +250,7 @@ lc_contact_solve lc_contact_solver_run(lc_contact_row *rows, int nrows, double *
                 /* the momentum beta * p_old, applied to the impulses and the velocities */
                 r->lambda_n += an;
                 r->lambda_t += at;
-                if (an != 0.0 || at != 0.0) lc_contact_row_apply(r, an, at, v, inv_mass, inv_inertia);
+                if (an != 0.0 || at != 0.0) row_apply(r, an, at, v, inv_mass, inv_inertia);
             }
             r->prev_n = r->lambda_n;
             r->prev_t = r->lambda_t;
