@@ -25,11 +25,13 @@
 #include "contact_cache.h"
 #include "contact_exact.h"
 #include "contact_solver.h"
+#include "kept_touches.h"
 #include "tunables.h"
 #include "world.h"
 
 struct lc_contact_regime {
     lc_contact_cache *cache;
+    lc_kept_touches *kept;
     lc_buf b_local;      /* int per world row: the row's index in the island being advanced, else -1 */
     int local_rows;      /* rows of b_local that hold -1 outside an island */
     lc_buf b_touch;      /* the sub-step's touches */
@@ -44,6 +46,8 @@ struct lc_contact_regime {
     lc_buf b_mprgp;      /* project_by_mprgp's vectors */
     lc_buf b_exact;      /* contact_exact.c's scratch */
     lc_buf b_vstart;     /* start velocities of an exact solve */
+    lc_buf b_known;      /* per flow row: 1 if the last step kept a force for its point (even 0) */
+    lc_buf b_margin;     /* per island pair: the margin of the last end-of-step search */
 };
 
 lc_contact_regime *lc_contact_regime_create(void)
@@ -51,7 +55,10 @@ lc_contact_regime *lc_contact_regime_create(void)
     lc_contact_regime *cr = calloc(1, sizeof *cr);
     if (cr == NULL) return NULL;
     cr->cache = lc_contact_cache_create();
-    if (cr->cache == NULL) {
+    cr->kept = lc_kept_touches_create();
+    if (cr->cache == NULL || cr->kept == NULL) {
+        lc_contact_cache_destroy(cr->cache);
+        lc_kept_touches_destroy(cr->kept);
         free(cr);
         return NULL;
     }
@@ -62,6 +69,7 @@ void lc_contact_regime_destroy(lc_contact_regime *cr)
 {
     if (cr == NULL) return;
     lc_contact_cache_destroy(cr->cache);
+    lc_kept_touches_destroy(cr->kept);
     lc_buf_free(&cr->b_local);
     lc_buf_free(&cr->b_touch);
     lc_buf_free(&cr->b_end);
@@ -76,14 +84,28 @@ void lc_contact_regime_destroy(lc_contact_regime *cr)
     lc_buf_free(&cr->b_mprgp);
     lc_buf_free(&cr->b_exact);
     lc_buf_free(&cr->b_vstart);
+    lc_buf_free(&cr->b_known);
+    lc_buf_free(&cr->b_margin);
     free(cr);
 }
 
-int lc_contact_regime_begin_step(lc_contact_regime *cr) { return lc_contact_cache_next_step(cr->cache); }
+int lc_contact_regime_begin_step(lc_contact_regime *cr)
+{
+    int a = lc_contact_cache_next_step(cr->cache), b = lc_kept_touches_next_step(cr->kept);
+    return a != 0 || b != 0 ? -1 : 0;
+}
 
-void lc_contact_regime_retry(lc_contact_regime *cr) { lc_contact_cache_drop_stored(cr->cache); }
+void lc_contact_regime_retry(lc_contact_regime *cr)
+{
+    lc_contact_cache_drop_stored(cr->cache);
+    lc_kept_touches_drop_stored(cr->kept);
+}
 
-void lc_contact_regime_forget(lc_contact_regime *cr) { lc_contact_cache_clear(cr->cache); }
+void lc_contact_regime_forget(lc_contact_regime *cr)
+{
+    lc_contact_cache_clear(cr->cache);
+    lc_kept_touches_clear(cr->kept);
+}
 
 /* The island's bodies as the solver sees them: velocities at the start of the sub-step (v0), the
  * solver's velocities (v), inverse mass and inertia, applied accelerations (acc), projection
@@ -101,6 +123,8 @@ typedef struct island_ctx {
     body_arrays b;
     int small;           /* transitions are located (LC_CONTACT_LOCATE_MAX_BODIES) */
     int precise;         /* solves run to convergence (LC_CONTACT_PRECISE_SWEEPS, _EXACT_POINTS) */
+    double start_h;      /* start_margin's h */
+    double dt;           /* the island's step */
     double residual;
     double overlap;      /* m, deepest overlap the last advance() left */
     double unpaid;       /* J, energy gain the last advance() kept (its kinetic energy could not pay) */
@@ -164,8 +188,8 @@ static int applied(island_ctx *c)
 }
 
 /* How far a pair's points can close on each other within h at most: the relative speed of their
- * farthest points and the relative applied acceleration. */
-static double closing_bound(const island_ctx *c, int a, int b, double h)
+ * farthest points and the relative applied acceleration (its term times acc_factor). */
+static double closing_bound(const island_ctx *c, int a, int b, double h, double acc_factor)
 {
     const lc_world *w = c->w;
     const double *sa = &w->state[a * 6], *sb = &w->state[b * 6];
@@ -178,18 +202,34 @@ static double closing_bound(const island_ctx *c, int a, int b, double h)
         if (lb >= 0) { ax -= c->b.acc[lb * 3]; ay -= c->b.acc[lb * 3 + 1]; al += fabs(c->b.acc[lb * 3 + 2]) * w->shape[b].radius; }
         acc = sqrt(ax * ax + ay * ay) + al;
     }
-    return h * v + 0.5 * h * h * acc;
+    return h * v + 0.5 * h * h * acc * acc_factor;
 }
 
-/* Every contact point of the island's pairs at the current state: within contact_distance plus
- * `reach`, or (speculative) within what the pair can close in h. Returns the count or -1. */
-static int collect(island_ctx *c, double h, lc_buf *buf, int speculative, double reach)
+/* The search margin of a pair at the start of a step of h: contact_distance and what the pair can close
+ * in h (speculative points). ctx: the island_ctx, h in its field start_h. */
+static double start_margin(const void *ctx, int a, int b)
+{
+    const island_ctx *c = ctx;
+    return c->w->def.contact_distance + closing_bound(c, a, b, c->start_h, 1.0);
+}
+
+enum { SEARCH_NEAR, SEARCH_STEP, SEARCH_NEXT_STEP };
+
+/* Every contact point of the island's pairs at the current state within contact_distance plus `reach`,
+ * and: SEARCH_STEP, within what the pair can close in h (speculative points); SEARCH_NEXT_STEP, within
+ * what it can close in a next step of h, with the acceleration term doubled (the accelerations there are
+ * those of the end state, which springs may have changed), so the touches can begin that step
+ * (kept_touches.h). margin: NULL, or per pair the margin searched. Returns the count or -1. */
+static int collect(island_ctx *c, double h, lc_buf *buf, int mode, double reach, double *margin)
 {
     lc_world *w = c->w;
     int k, n = 0;
     for (k = 0; k < c->isl->npairs; ++k) {
         int a = c->isl->pairs[2 * k], b = c->isl->pairs[2 * k + 1];
-        double gap = w->def.contact_distance + reach + (speculative ? closing_bound(c, a, b, h) : 0.0);
+        double gap = w->def.contact_distance + reach +
+                     (mode == SEARCH_STEP ? closing_bound(c, a, b, h, 1.0)
+                      : mode == SEARCH_NEXT_STEP ? closing_bound(c, a, b, h, 2.0) : 0.0);
+        if (margin != NULL) margin[k] = gap;
         n = lc_collect_touches_within(w, w->state, a, b, gap, w->def.contact_distance, buf, n);
         if (n < 0) return -1;
     }
@@ -325,11 +365,13 @@ static int impacts(island_ctx *c, lc_touch *t, int nt, double h)
     return hits;
 }
 
-/* Touching points without a force from the last step start from the weight they carry at rest, shared down the
- * "rests on" graph by the lever rule (static_load.c): a stack or pyramid created at rest, or a body
- * landing on one, starts at its answer, where Gauss-Seidel from zero needs sweeps in the square of the
- * stack's height (a 20-stack sagged and bounced for a second) and a 1000:1 mass ratio never gets there. */
-static int cold_start(island_ctx *c, const lc_touch *t, int nt, double h, lc_contact_row *rows)
+/* Touching points the last step kept no force for (new contacts) start from the weight they carry at
+ * rest, shared down the "rests on" graph by the lever rule (static_load.c): a stack or pyramid created at
+ * rest, or a body landing on one, starts at its answer, where Gauss-Seidel from zero needs sweeps in the
+ * square of the stack's height (a 20-stack sagged and bounced for a second) and a 1000:1 mass ratio never
+ * gets there. known[i]: row i's point had a kept force (a kept 0 too: a side contact that carries
+ * nothing is not new, and re-spreading the loads every step cost a resting pyramid 3%). */
+static int cold_start(island_ctx *c, const lc_touch *t, int nt, double h, const uint8_t *known, lc_contact_row *rows)
 {
     lc_world *w = c->w;
     int i, m = 0, cold = 0;
@@ -337,7 +379,7 @@ static int cold_start(island_ctx *c, const lc_touch *t, int nt, double h, lc_con
     int *which;
     double *f;
     for (i = 0; i < nt; ++i)
-        if (t[i].gap < w->def.contact_distance && rows[i].lambda_n == 0.0 && rows[i].lambda_t == 0.0) cold = 1;
+        if (t[i].gap < w->def.contact_distance && !known[i]) cold = 1;
     if (!cold) return 0;
     closed = lc_buf_get(&c->cr->b_cold, (size_t)nt * sizeof(lc_touch));
     f = lc_buf_get(&c->cr->b_cold_load, (size_t)nt * (sizeof(double) + sizeof(int)));
@@ -353,7 +395,7 @@ static int cold_start(island_ctx *c, const lc_touch *t, int nt, double h, lc_con
     if (lc_static_load_forces_of(w, closed, m, c->local, c->isl->rows, c->b.n, f) != 0) return -1;
     for (i = 0; i < m; ++i) {
         lc_contact_row *r = &rows[which[i]];
-        if (r->lambda_n == 0.0 && r->lambda_t == 0.0 && f[i] > 0.0) r->lambda_n = f[i] * h;
+        if (!known[which[i]] && f[i] > 0.0) r->lambda_n = f[i] * h;
     }
     return 0;
 }
@@ -364,6 +406,8 @@ static int flow(island_ctx *c, const lc_touch *t, int nt, double h, lc_contact_r
     lc_world *w = c->w;
     double gc = w->def.contact_gap;
     int i, nb = c->b.n;
+    uint8_t *known = lc_buf_get(&c->cr->b_known, (size_t)(nt > 0 ? nt : 1));
+    if (known == NULL) return -1;
     for (i = 0; i < nb * 3; ++i) c->b.v[i] = c->b.v0[i] + h * c->b.acc[i];
     for (i = 0; i < nt; ++i) {
         lc_contact_row *r = &rows[i];
@@ -372,12 +416,13 @@ static int flow(island_ctx *c, const lc_touch *t, int nt, double h, lc_contact_r
         lc_contact_row_velocity(r, c->b.v0, &un, &ut);
         r->target_n = -un - 2.0 * fmax(t[i].gap - gc, 0.0) / h;
         r->slip = ut > LC_CONTACT_SLIP_SPEED ? 1 : ut < -LC_CONTACT_SLIP_SPEED ? -1 : 0;
-        if (lc_contact_cache_find(c->cr->cache, key_of(w, &t[i]), &fn, &ft)) {
+        known[i] = (uint8_t)lc_contact_cache_find(c->cr->cache, key_of(w, &t[i]), &fn, &ft);
+        if (known[i]) {
             r->lambda_n = fn * h;
             r->lambda_t = ft * h;
         }
     }
-    if (cold_start(c, t, nt, h, rows) != 0) return -1;
+    if (cold_start(c, t, nt, h, known, rows) != 0) return -1;
     return solve(c, rows, nt);
 }
 
@@ -508,7 +553,9 @@ static int project(island_ctx *c, double *left)
 {
     lc_world *w = c->w;
     double gp = fmin(LC_CONTACT_PROJECTION_GAP, 1e-3 * w->def.contact_gap), reach = 0.0;
+    double *margin = lc_buf_get(&c->cr->b_margin, (size_t)(c->isl->npairs > 0 ? c->isl->npairs : 1) * sizeof(double));
     int pass, i, k, nt = 0;
+    if (margin == NULL) return -1;
     for (pass = 0;; ++pass) {
         lc_touch *t;
         lc_contact_row *rows;
@@ -516,7 +563,7 @@ static int project(island_ctx *c, double *left)
         int any = 0;
         /* the points within twice the deepest overlap too: pushing a pair apart by that much can push
          * a neighbour in (a row of boxes), and a point the solve does not hold is one pass more each */
-        nt = collect(c, 0.0, &c->cr->b_end, 0, reach);
+        nt = collect(c, c->dt, &c->cr->b_end, SEARCH_NEXT_STEP, reach, margin);
         if (nt < 0) return -1;
         t = (lc_touch *)c->cr->b_end.p;
         *left = 0.0;
@@ -527,7 +574,7 @@ static int project(island_ctx *c, double *left)
             }
         if (reach < 2.0 * *left) {
             reach = 2.0 * *left;
-            nt = collect(c, 0.0, &c->cr->b_end, 0, reach);
+            nt = collect(c, c->dt, &c->cr->b_end, SEARCH_NEXT_STEP, reach, margin);
             if (nt < 0) return -1;
             t = (lc_touch *)c->cr->b_end.p;
         }
@@ -615,7 +662,7 @@ static int finish(island_ctx *c, lc_touch *end, int nend, const lc_touch *t, con
         x->tangent = ft;
         if (x->elasticity < 1.0) w->rests_dissipative[x->a] = w->rests_dissipative[x->b] = 1;
         if (lc_push_contact(w, x, LC_CONTACT_RESTING) != 0) return -1;
-        if (fn > 0.0 && lc_contact_cache_store(c->cr->cache, key_of(w, x), fn, ft) != 0) return -1;
+        if (lc_contact_cache_store(c->cr->cache, key_of(w, x), fn, ft) != 0) return -1;
     }
     for (i = 0; i < nend; ++i)
         if (end[i].gap < w->def.contact_distance) w->last.resting_contacts++;
@@ -639,7 +686,10 @@ static int advance(island_ctx *c, double dt, int driven, double e0, double size0
         double tau;
         h = left;
         if (applied(c) != 0) return -1;
-        *nt = collect(c, h, &cr->b_touch, 1, 0.0);
+        /* the step's first search is usually the last step's end search, kept */
+        c->start_h = h;
+        *nt = left == dt ? lc_kept_touches_take(cr->kept, w, isl, dt, start_margin, c, &cr->b_touch) : -2;
+        if (*nt == -2) *nt = collect(c, h, &cr->b_touch, SEARCH_STEP, 0.0, NULL);
         if (*nt < 0) return -1;
         t = (lc_touch *)cr->b_touch.p;
         rows = lc_buf_get(&cr->b_rows, (size_t)(*nt > 0 ? *nt : 1) * sizeof(lc_contact_row));
@@ -681,6 +731,7 @@ int lc_contact_advance(lc_world *w, lc_contact_regime *cr, const lc_island *isl,
     c.cr = cr;
     c.isl = isl;
     c.small = isl->nrows <= LC_CONTACT_LOCATE_MAX_BODIES;
+    c.dt = dt;
     if (map_island(&c) != 0) return -1;
     w->last.contact_islands++;
     start = lc_buf_get(&cr->b_start, (size_t)(isl->nrows > 0 ? isl->nrows : 1) * 6 * sizeof(double));
@@ -712,7 +763,8 @@ int lc_contact_advance(lc_world *w, lc_contact_regime *cr, const lc_island *isl,
         for (k = 0; k < 6; ++k)
             if (!isfinite(w->state[isl->rows[i] * 6 + k])) status = -2;
     if (status == 0 &&
-        finish(&c, (lc_touch *)cr->b_end.p, nend, (lc_touch *)cr->b_touch.p, (lc_contact_row *)cr->b_rows.p, nt, h) != 0)
+        (finish(&c, (lc_touch *)cr->b_end.p, nend, (lc_touch *)cr->b_touch.p, (lc_contact_row *)cr->b_rows.p, nt, h) != 0 ||
+         lc_kept_touches_store(cr->kept, w, isl, dt, (const lc_touch *)cr->b_end.p, nend, (const double *)cr->b_margin.p) != 0))
         goto oom;
     if (c.residual > w->last.max_contact_residual) w->last.max_contact_residual = c.residual;
     unmap_island(&c);
