@@ -257,7 +257,8 @@ static void make_row(const island_ctx *c, const lc_touch *t, lc_contact_row *r)
 static void count_solve(island_ctx *c, lc_contact_solve s, int rows);
 
 /* Solves rows[0..m) from the velocities in b.v (their start) into b.v: Gauss-Seidel with momentum from
- * the rows' warm start (contact_solver.c), at most contact_iterations sweeps, to contact_tolerance. In a
+ * the rows' warm start (contact_solver.c), at most contact_iterations sweeps (scaled up for fewer than
+ * LC_CONTACT_SMALL_POINTS points), to contact_tolerance. In a
  * precise retry (lc_contact_advance) a problem of at most LC_CONTACT_PRECISE_EXACT_POINTS points is
  * solved exactly (contact_exact.c) and confirmed by sweeps from that answer, a larger one by up to
  * LC_CONTACT_PRECISE_SWEEPS sweeps. Returns 0, or -1 without memory. */
@@ -267,6 +268,8 @@ static int solve(island_ctx *c, lc_contact_row *rows, int m)
     lc_contact_solve s;
     int sweeps = c->precise && w->def.contact_iterations < LC_CONTACT_PRECISE_SWEEPS ? LC_CONTACT_PRECISE_SWEEPS
                                                                                      : w->def.contact_iterations;
+    if (!c->precise && m > 0 && m < LC_CONTACT_SMALL_POINTS)
+        sweeps = (int)fmin((double)sweeps * LC_CONTACT_SMALL_POINTS / m, (double)LC_CONTACT_PRECISE_SWEEPS);
     if (c->precise && m > 0 && m <= LC_CONTACT_PRECISE_EXACT_POINTS) {
         double *scratch = lc_buf_get(&c->cr->b_exact, lc_contact_exact_scratch(m) * sizeof(double));
         double *vstart = lc_buf_get(&c->cr->b_vstart, (size_t)c->b.n * 3 * sizeof(double));

@@ -37,12 +37,20 @@
  * cone's work on such a point is at most mu lambda_n times this: 1e-9 J for a 1 kg body at dt 1/60
  * (resting_speed, 1e-4 m/s by default and up to 10, made it up to 7e-5 J in one step of a pile). */
 #define LC_CONTACT_SLIP_SPEED 1e-6
+/* A solve of m points fewer than this may take contact_iterations x this / m sweeps: the work of one of
+ * this size. A few bodies whose friction and normal impulses trade through their rotation need 40-60
+ * sweeps where a large pile's warm-started solve needs a few; cut at contact_iterations, such an island
+ * ended with its energy guard unmet and was taken again precisely (exactly, by pivoting: 70% of the CPU
+ * of 30 boxes settling in a box). */
+#define LC_CONTACT_SMALL_POINTS 64
 /* When a contact-regime step ends with an overlap it cannot project away or an energy gain the island's
  * kinetic energy cannot pay (a nearly resting island whose solves stopped at contact_iterations, 1e-4
  * to 5e-3 m/s off), the step is taken again with solves of up to this many sweeps and exact ones up to
  * this many points (a 16-point problem: ~40 pivots, where the sweeps need 100-700). */
 #define LC_CONTACT_PRECISE_SWEEPS 1000
+#ifndef LC_CONTACT_PRECISE_EXACT_POINTS
 #define LC_CONTACT_PRECISE_EXACT_POINTS 32
+#endif
 /* Islands of at most this many bodies whose contact-regime step, precise too, leaves an overlap or an
  * energy gain above the allowances below are taken again in the event regime, exact at that size. A
  * larger island keeps the precise step and counts it (lc_counters contact_unresolved): the event

@@ -119,7 +119,8 @@ typedef struct lc_world_def {
     lc_broadphase broadphase;      /* default LC_BROADPHASE_AUTO */
     int broadphase_threshold;      /* body count at which AUTO switches to sort-and-sweep, [2, 1e6], default 32 */
     lc_regime regime;              /* default LC_REGIME_AUTO */
-    int contact_iterations;        /* contact regime: most solver sweeps per solve, [1, 1e6], default 30 */
+    int contact_iterations;        /* contact regime: most solver sweeps per solve of 64 points or more (a
+                                      smaller one may take proportionally more), [1, 1e6], default 30 */
     double contact_tolerance;      /* contact regime: m/s, a solve stops at a sweep that changes no point's
                                       velocity by more than this, [0, 1], default 1e-10 */
 } lc_world_def;
