@@ -69,13 +69,18 @@ static inline void friction_bounds(const lc_contact_row *r, double *lo, double *
     *hi = r->slip > 0 ? 0.0 : c;
 }
 
-/* The off-diagonal entry of A = J M^-1 J^T between the normal rows of two points of one body pair. */
-static double coupling(const lc_contact_row *r, const lc_contact_row *q, const double *inv_mass,
-                       const double *inv_inertia)
+/* One row of J: its direction and its lever arms about body a's and body b's centres. */
+typedef struct jdir { double x, y, la, lb; } jdir;
+
+static jdir normal_dir(const lc_contact_row *r) { jdir d; d.x = r->nx; d.y = r->ny; d.la = r->rna; d.lb = r->rnb; return d; }
+static jdir tangent_dir(const lc_contact_row *r) { jdir d; d.x = -r->ny; d.y = r->nx; d.la = r->rta; d.lb = r->rtb; return d; }
+
+/* The entry of A = J M^-1 J^T between rows p and q of one body pair (r's bodies). */
+static double coupling(const lc_contact_row *r, jdir p, jdir q, const double *inv_mass, const double *inv_inertia)
 {
-    double k = 0.0, nn = r->nx * q->nx + r->ny * q->ny;
-    if (r->a >= 0) k += inv_mass[r->a] * nn + inv_inertia[r->a] * r->rna * q->rna;
-    if (r->b >= 0) k += inv_mass[r->b] * nn + inv_inertia[r->b] * r->rnb * q->rnb;
+    double k = 0.0, pq = p.x * q.x + p.y * q.y;
+    if (r->a >= 0) k += inv_mass[r->a] * pq + inv_inertia[r->a] * p.la * q.la;
+    if (r->b >= 0) k += inv_mass[r->b] * pq + inv_inertia[r->b] * p.lb * q.lb;
     return k;
 }
 
@@ -91,20 +96,42 @@ static void prepare_block(lc_contact_row *r, const double *inv_mass, const doubl
     if (r->a != q->a || r->b != q->b || !(r->mass_n > 0.0) || !(q->mass_n > 0.0)) return;
     k11 = 1.0 / r->mass_n;
     k22 = 1.0 / q->mass_n;
-    k12 = coupling(r, q, inv_mass, inv_inertia);
+    k12 = coupling(r, normal_dir(r), normal_dir(q), inv_mass, inv_inertia);
     det = k11 * k22 - k12 * k12;
     /* nearly dependent rows (two points at one place): row by row */
     if (!(det > 1e-9 * k11 * k22)) return;
     r->block = 1;
     r->k12 = k12;
     r->det = det;
+    /* what the block's normal impulses and the first friction impulse do to the tangent velocities */
+    r->k_t1n2 = coupling(r, tangent_dir(r), normal_dir(q), inv_mass, inv_inertia);
+    r->k_t2n1 = coupling(r, tangent_dir(q), normal_dir(r), inv_mass, inv_inertia);
+    r->k_t2t1 = coupling(r, tangent_dir(q), tangent_dir(r), inv_mass, inv_inertia);
 }
 
-/* The block's normal impulses; returns the largest change in velocity units. */
+/* A friction row's new impulse in the cone of its current normal impulse, from its tangent velocity ut;
+ * returns the change of lambda_t. */
+static inline double friction_step(lc_contact_row *r, double ut)
+{
+    double lt, lo, hi, dt;
+    friction_bounds(r, &lo, &hi);
+    lt = r->lambda_t - r->mass_t * ut;
+    lt = lt < lo ? lo : lt > hi ? hi : lt;
+    dt = lt - r->lambda_t;
+    r->lambda_t = lt;
+    return dt;
+}
+
+static inline int has_friction(const lc_contact_row *r) { return r->mu > 0.0 || r->lambda_t != 0.0; }
+
+/* A block's normal rows, then its two friction rows, Gauss-Seidel in that order: the velocities are read
+ * once and written once, the friction rows' tangent velocities updated through the couplings of A.
+ * Returns the largest change in velocity units. */
 static inline double solve_block(lc_contact_row *r, double *v, const double *inv_mass, const double *inv_inertia)
 {
     lc_contact_row *q = r + 1;
     double u1, u2, t1, t2, k11 = 1.0 / r->mass_n, k22 = 1.0 / q->mass_n, k12 = r->k12, b1, b2, x1, x2, d1, d2;
+    double dt1 = 0.0, dt2 = 0.0, change;
     row_velocity(r, v, &u1, &t1);
     row_velocity(q, v, &u2, &t2);
     /* u' - target = K x + b for new impulses x */
@@ -134,39 +161,32 @@ static inline double solve_block(lc_contact_row *r, double *v, const double *inv
     d2 = x2 - q->lambda_n;
     r->lambda_n = x1;
     q->lambda_n = x2;
-    if (d1 != 0.0) row_apply(r, d1, 0.0, v, inv_mass, inv_inertia);
-    if (d2 != 0.0) row_apply(q, d2, 0.0, v, inv_mass, inv_inertia);
-    return larger(fabs(d1) * k11, fabs(d2) * k22);
+    if (has_friction(r)) dt1 = friction_step(r, t1 + d1 * r->k_tn + d2 * r->k_t1n2);
+    if (has_friction(q)) dt2 = friction_step(q, t2 + d1 * r->k_t2n1 + d2 * q->k_tn + dt1 * r->k_t2t1);
+    if (d1 != 0.0 || dt1 != 0.0) row_apply(r, d1, dt1, v, inv_mass, inv_inertia);
+    if (d2 != 0.0 || dt2 != 0.0) row_apply(q, d2, dt2, v, inv_mass, inv_inertia);
+    change = larger(fabs(d1) * k11, fabs(d2) * k22);
+    if (r->mass_t > 0.0) change = larger(change, fabs(dt1) / r->mass_t);
+    if (q->mass_t > 0.0) change = larger(change, fabs(dt2) / q->mass_t);
+    return change;
 }
 
-/* A normal row alone; returns its change in velocity units. */
-static inline double solve_normal(lc_contact_row *r, double *v, const double *inv_mass, const double *inv_inertia)
+/* A normal row, then its friction row (Gauss-Seidel: the friction sees the new normal impulse, its
+ * tangent velocity updated through A's coupling); returns the larger change in velocity units. */
+static inline double solve_row(lc_contact_row *r, double *v, const double *inv_mass, const double *inv_inertia)
 {
-    double un, ut, ln, dn;
+    double un, ut, ln, dn, dt = 0.0, change = 0.0;
     row_velocity(r, v, &un, &ut);
     ln = r->lambda_n + r->mass_n * (r->target_n - un);
     if (!(ln > 0.0)) ln = 0.0;
     dn = ln - r->lambda_n;
     r->lambda_n = ln;
-    if (dn == 0.0) return 0.0;
-    row_apply(r, dn, 0.0, v, inv_mass, inv_inertia);
-    return r->mass_n > 0.0 ? fabs(dn) / r->mass_n : 0.0;
-}
-
-/* A friction row, in the cone of its current normal impulse; returns its change in velocity units. */
-static inline double solve_friction(lc_contact_row *r, double *v, const double *inv_mass, const double *inv_inertia)
-{
-    double un, ut, lt, lo, hi, dt;
-    if (!(r->mu > 0.0) && r->lambda_t == 0.0) return 0.0;
-    row_velocity(r, v, &un, &ut);
-    friction_bounds(r, &lo, &hi);
-    lt = r->lambda_t - r->mass_t * ut;
-    lt = lt < lo ? lo : lt > hi ? hi : lt;
-    dt = lt - r->lambda_t;
-    r->lambda_t = lt;
-    if (dt == 0.0) return 0.0;
-    row_apply(r, 0.0, dt, v, inv_mass, inv_inertia);
-    return r->mass_t > 0.0 ? fabs(dt) / r->mass_t : 0.0;
+    if (has_friction(r)) dt = friction_step(r, ut + dn * r->k_tn);
+    if (dn == 0.0 && dt == 0.0) return 0.0;
+    row_apply(r, dn, dt, v, inv_mass, inv_inertia);
+    if (r->mass_n > 0.0) change = fabs(dn) / r->mass_n;
+    if (r->mass_t > 0.0) change = larger(change, fabs(dt) / r->mass_t);
+    return change;
 }
 
 /* One Gauss-Seidel sweep over the rows; returns its largest change in velocity units. */
@@ -178,12 +198,9 @@ static double sweep(lc_contact_row *rows, int nrows, double *v, const double *in
         lc_contact_row *r = &rows[i];
         if (r->block) {
             change = larger(change, solve_block(r, v, inv_mass, inv_inertia));
-            change = larger(change, solve_friction(r, v, inv_mass, inv_inertia));
-            change = larger(change, solve_friction(r + 1, v, inv_mass, inv_inertia));
             ++i;
         } else {
-            change = larger(change, solve_normal(r, v, inv_mass, inv_inertia));
-            change = larger(change, solve_friction(r, v, inv_mass, inv_inertia));
+            change = larger(change, solve_row(r, v, inv_mass, inv_inertia));
         }
     }
     return change;
@@ -202,6 +219,7 @@ lc_contact_solve lc_contact_solver_run(lc_contact_row *rows, int nrows, double *
         double lo, hi;
         r->mass_n = row_mass(r, r->rna, r->rnb, inv_mass, inv_inertia);
         r->mass_t = row_mass(r, r->rta, r->rtb, inv_mass, inv_inertia);
+        r->k_tn = coupling(r, tangent_dir(r), normal_dir(r), inv_mass, inv_inertia);
         r->block = 0;
         if (!(isfinite(r->lambda_n) && r->lambda_n > 0.0)) r->lambda_n = 0.0;
         if (!isfinite(r->lambda_t)) r->lambda_t = 0.0;

@@ -16,7 +16,9 @@
  * effective mass, then its friction row onto the box of the current lambda_n (Moreau's nonsmooth
  * Gauss-Seidel, NSGS). Two consecutive rows of one body pair (a face's two points) have their normal
  * rows solved together exactly, as a 2 x 2 complementarity problem, before their friction rows.
- * Velocities are updated after every row, so a sweep costs O(rows).
+ * Velocities are updated after every point (its normal row and its friction row read the velocities
+ * once and write them once, the friction row's tangent velocity updated through A's coupling), so a
+ * sweep costs O(rows).
  * Stopping rule: a sweep whose largest change of any row, in velocity units (|d lambda| times the
  * row's inverse effective mass, m/s), is at most `tolerance` ends the solve: every row then met its
  * condition to `tolerance` when it was visited. Otherwise the solve ends after `max_sweeps` sweeps,
@@ -43,6 +45,8 @@ typedef struct lc_contact_row {
     int block;             /* 1: this row's and the next's normal rows (two points of one body pair) are
                               solved together, exactly */
     double k12, det;       /* the block's coupling and the determinant of its 2 x 2 matrix */
+    double k_tn;           /* A's entry between this row's tangent and normal */
+    double k_t1n2, k_t2n1, k_t2t1; /* a block's cross entries (first row: 1, next: 2) */
     double prev_n, prev_t; /* impulses before the last sweep, and the conjugate direction */
     double dir_n, dir_t;
 } lc_contact_row;
