@@ -290,83 +290,6 @@ static int gather_impact(lc_world *w, const double *state, const lc_crossing *c,
     return n;
 }
 
-int lc_push_contact(lc_world *w, const lc_touch *t, lc_contact_kind kind)
-{
-    lc_contact *c;
-    if (w->contact_count == w->contact_cap) {
-        int cap = w->contact_cap ? 2 * w->contact_cap : 32;
-        void *p = realloc(w->contacts, (size_t)cap * sizeof *w->contacts);
-        if (p == NULL) return -1;
-        w->contacts = p;
-        w->contact_cap = cap;
-    }
-    c = &w->contacts[w->contact_count++];
-    c->body_a = w->ids[t->a];
-    c->body_b = w->ids[t->b];
-    c->point = t->p;
-    c->normal = t->n;
-    c->gap = t->gap;
-    c->time = w->time;
-    c->kind = kind;
-    if (kind == LC_CONTACT_COLLISION) {
-        c->normal_velocity = t->vn_pre;
-        c->impulse = t->value;
-        c->tangent_impulse = t->tangent;
-        c->force = 0.0;
-    } else {
-        c->normal_velocity = t->vn;
-        c->impulse = 0.0;
-        c->tangent_impulse = 0.0;
-        c->force = t->value;
-    }
-    return 0;
-}
-
-static void add_counters(lc_counters *total, const lc_counters *last)
-{
-    total->steps += last->steps;
-    total->force_evaluations += last->force_evaluations;
-    total->analytic_advances += last->analytic_advances;
-    total->broadphase_pairs += last->broadphase_pairs;
-    total->brute_force_steps += last->brute_force_steps;
-    total->sort_and_sweep_steps += last->sort_and_sweep_steps;
-    total->collisions += last->collisions;
-    total->impulses += last->impulses;
-    total->toi_searches += last->toi_searches;
-    total->toi_iterations += last->toi_iterations;
-    total->serial_iterations += last->serial_iterations;
-    total->inelastic_fallbacks += last->inelastic_fallbacks;
-    total->resting_contacts += last->resting_contacts;
-    total->contact_solves += last->contact_solves;
-    total->contact_solve_iterations += last->contact_solve_iterations;
-    total->solver_work += last->solver_work;
-    total->impulse_solves += last->impulse_solves;
-    total->position_projections += last->position_projections;
-    total->quiet_advances += last->quiet_advances;
-    total->islands += last->islands;
-    total->island_retries += last->island_retries;
-    total->contact_islands += last->contact_islands;
-    total->contact_points += last->contact_points;
-    total->contact_sweeps += last->contact_sweeps;
-    total->contact_exact_solves += last->contact_exact_solves;
-    total->contact_cuts += last->contact_cuts;
-    total->contact_precise_retries += last->contact_precise_retries;
-    total->energy_clamps += last->energy_clamps;
-    total->contact_unresolved += last->contact_unresolved;
-    if (last->max_unresolved_overlap > total->max_unresolved_overlap) total->max_unresolved_overlap = last->max_unresolved_overlap;
-    if (last->max_unresolved_energy > total->max_unresolved_energy) total->max_unresolved_energy = last->max_unresolved_energy;
-    if (last->max_contact_residual > total->max_contact_residual) total->max_contact_residual = last->max_contact_residual;
-    if (last->max_lcp_residual > total->max_lcp_residual) total->max_lcp_residual = last->max_lcp_residual;
-    total->time_step += last->time_step;
-    total->time_detection += last->time_detection;
-    total->time_integration += last->time_integration;
-    total->time_toi_search += last->time_toi_search;
-    total->time_impulses += last->time_impulses;
-    total->time_projection += last->time_projection;
-    total->time_contact_forces += last->time_contact_forces;
-    total->time_contact_regime += last->time_contact_regime;
-}
-
 /* Post-stabilisation: when a point ends the step closer than half the contact gap (or inside another
  * body), every touch is moved back to at least the contact gap by the smallest displacement the
  * response matrix allows (an LCP on positions). Positions only: the contact forces stop relative
@@ -777,79 +700,6 @@ static int keep_clean_crossings(lc_world *w, const uint8_t *dirty, double tmin)
     return kept;
 }
 
-/* Contact forces do no work beyond round-off; a trial interval in which the bodies they act on gain
- * more than their kinetic energy again (plus 1 J), gravity's work counted, has blown up: a point
- * driven by forces of 1e23 N against an edge turning at 1e6 rad/s (fuzzer inputs), never a real
- * scene. Bodies with thrust, torque or a spring can gain energy legitimately: then no verdict. */
-static int contact_energy_blew_up(const lc_world *w, const double *s0, const double *s1, const lc_touch *rest,
-                                  int nrest, uint8_t *mark)
-{
-    double ke0 = 0.0, gain = 0.0;
-    int i, verdict = 1;
-    for (i = 0; i < nrest; ++i) mark[rest[i].a] = mark[rest[i].b] = 1;
-    for (i = 0; i < w->spring_count && verdict; ++i) {
-        int a = lc_world_body_index(w, w->springs[i].def.body_a);
-        int b = w->springs[i].def.body_b == LC_WORLD_ANCHOR ? -1 : lc_world_body_index(w, w->springs[i].def.body_b);
-        if ((a >= 0 && mark[a]) || (b >= 0 && mark[b])) verdict = 0;
-    }
-    for (i = 0; i < w->count; ++i) {
-        const double *a = &s0[i * 6], *b = &s1[i * 6];
-        double m, in;
-        if (!mark[i]) continue;
-        mark[i] = 0;
-        if (w->is_static[i]) continue;
-        if (lc_body_driven(w, i)) verdict = 0;   /* thrusters too: a 100 N thruster on a block resting on
-                                                   * the floor failed its first step here */
-        m = w->inv_mass[i] > 0.0 ? 1.0 / w->inv_mass[i] : 0.0;
-        in = w->inv_inertia[i] > 0.0 ? 1.0 / w->inv_inertia[i] : 0.0;
-        ke0 += 0.5 * m * (a[SVX] * a[SVX] + a[SVY] * a[SVY]) + 0.5 * in * a[SW] * a[SW];
-        gain += 0.5 * m * (b[SVX] * b[SVX] + b[SVY] * b[SVY] - a[SVX] * a[SVX] - a[SVY] * a[SVY]) +
-                0.5 * in * (b[SW] * b[SW] - a[SW] * a[SW]) -
-                m * (w->def.gravity.x * (b[SX] - a[SX]) + w->def.gravity.y * (b[SY] - a[SY]));
-    }
-    return verdict && !(gain <= ke0 + 1.0);
-}
-
-/* Impacts (e <= 1), contact forces, damping and springs (their energy counted) take energy out or keep
- * it; only external forces, torques and thrusters put it in, at most |F| |v| dt. A step that ends with
- * more energy than it started with, beyond 1 J + 1e-3 of it plus ten times that bound on the driving
- * forces' work (with |v| the larger of the body's speeds at the step's two ends, and the |F|^2 dt^2 / m
- * a force adds from rest), has blown up: a 1e-12 m, 10 kg polygon at 1e6 m/s pushed by an external
- * force in a 12 m box went to 5.7e21 m/s within one 22 ms step and left the box (fuzz finding 26; no
- * single trial interval doubled its energy, which the per-interval check above looks for). A real
- * driving force's work grows with the speed, the blow-up's energy with its square. Measured before
- * the end-of-step projection, which may lift overlapping bodies against gravity; a step that starts
- * with bodies deep in each other is left to the projection. */
-static int step_energy_blew_up(const lc_world *w, const double *backup, double dt, int started_deep)
-{
-    lc_energy e0, e1;
-    double drive = 0.0;
-    int i, k;
-    /* a step of integration alone (no impact, no contact force) is checked by its finite state; the
-     * balance costs ~5 % of a 20-block step and is kept for the steps where contacts acted */
-    if (started_deep || (w->last.collisions == 0 && w->last.contact_solves == 0 && w->last.contact_islands == 0)) return 0;
-    for (i = 0; i < w->count; ++i) {
-        const double *a = &backup[i * 6], *b = &w->state[i * 6];
-        double f, tau, v, om;
-        if (w->is_static[i]) continue;
-        f = sqrt(lc_dot(w->ext_force[i], w->ext_force[i]));
-        tau = fabs(w->ext_torque[i]);
-        for (k = 0; k < w->thruster_count[i]; ++k) {
-            const lc_thruster *t = &w->thrusters[i][k];
-            double thrust = fabs(t->magnitude * t->level);
-            f += thrust;
-            tau += thrust * sqrt(lc_dot(t->point, t->point));
-        }
-        if (f == 0.0 && tau == 0.0) continue;
-        v = fmax(sqrt(a[SVX] * a[SVX] + a[SVY] * a[SVY]), sqrt(b[SVX] * b[SVX] + b[SVY] * b[SVY]));
-        om = fmax(fabs(a[SW]), fabs(b[SW]));
-        drive += 10.0 * (f * v + tau * om) * dt + f * f * dt * dt * w->inv_mass[i] + tau * tau * dt * dt * w->inv_inertia[i];
-    }
-    lc_compute_energy(w, backup, &e0);
-    lc_compute_energy(w, w->state, &e1);
-    return !(e1.total <= e0.total + 1.0 + 1e-3 * fabs(e0.total) + drive);
-}
-
 static lc_status step_failed(lc_world *w, const double *backup, double time0, lc_status s, const char *what)
 {
     lc_stage_end(w, &w->last.time_step, w->step_t0);
@@ -983,7 +833,7 @@ static lc_status event_step(lc_world *w, double dt, double t0, double time0, dou
             uint8_t *mark = lc_buf_get(&w->b_emark, (size_t)w->count);
             if (mark == NULL) goto oom;
             memset(mark, 0, (size_t)w->count);
-            if (contact_energy_blew_up(w, s0, s1, rest, nrest, mark))
+            if (lc_contact_energy_blew_up(w, s0, s1, rest, nrest, mark))
                 return step_failed(w, backup, time0, LC_ERR_NUMERIC,
                                    "contact forces gained energy (speeds or spins beyond what dt can resolve)");
         }
@@ -1149,7 +999,7 @@ static lc_status event_step(lc_world *w, double dt, double t0, double time0, dou
     }
     if (remaining == 0.0) w->time = t0 + dt;
     if (handover != NULL) *handover = -1;
-    if (step_energy_blew_up(w, backup, dt, started_deep))
+    if (lc_step_energy_blew_up(w, backup, dt, started_deep))
         return step_failed(w, backup, time0, LC_ERR_NUMERIC,
                            "the step gained far more energy than its external forces and thrusters can give "
                            "(speeds or spins beyond what dt can resolve)");
@@ -1287,7 +1137,7 @@ static lc_status advance_islands(lc_world *w, double dt, double time0, double *b
             w->excluded = NULL;
             *marks_known = 1;
             w->time = time0 + dt;
-            if (step_energy_blew_up(w, backup, dt, 0))
+            if (lc_step_energy_blew_up(w, backup, dt, 0))
                 return step_failed(w, backup, time0, LC_ERR_NUMERIC,
                                    "the step gained far more energy than its external forces and thrusters can give "
                                    "(speeds or spins beyond what dt can resolve)");
@@ -1348,7 +1198,7 @@ lc_status lc_world_step(lc_world *w, double dt)
         /* nothing to move: time still passes */
         w->time += dt;
         lc_stage_end(w, &w->last.time_step, w->step_t0);
-        add_counters(&w->total, &w->last);
+        lc_counters_add(&w->total, &w->last);
         w->error[0] = '\0';
         return LC_OK;
     }
@@ -1394,7 +1244,7 @@ lc_status lc_world_step(lc_world *w, double dt)
     /* the marks describe the end state unless the event regime could not tell (the next step looks) */
     w->regime_edits = marks_known ? w->edits : w->edits - 1;
     lc_stage_end(w, &w->last.time_step, w->step_t0);
-    add_counters(&w->total, &w->last);
+    lc_counters_add(&w->total, &w->last);
     w->error[0] = '\0';
     return LC_OK;
 }

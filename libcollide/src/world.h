@@ -277,9 +277,11 @@ int lc_resolve_impacts(lc_world *w, double *state, lc_touch *t, int n, int elast
 /* Approach speed (m/s) above which an impact of a pair of this elasticity bounces. */
 double lc_bounce_speed(const lc_world *w, double elasticity);
 
-/* ---- step.c: results ---- */
+/* ---- results.c ---- */
 /* Appends a contact of the step in progress (a touch at its current geometry). 0, or -1 without memory. */
 int lc_push_contact(lc_world *w, const lc_touch *t, lc_contact_kind kind);
+/* Adds a step's counters to the running totals (the max_* fields take the larger). */
+void lc_counters_add(lc_counters *total, const lc_counters *last);
 
 /* ---- time_of_impact.c ---- */
 /* Time in [0, h] at which the crossing's gap reaches the contact gap; integrates the listed rows. */
@@ -292,6 +294,12 @@ double lc_pair_time_of_impact(lc_world *w, const double *s0, double h, int a, in
 
 /* ---- energy.c ---- */
 void lc_compute_energy(const lc_world *w, const double *state, lc_energy *out);
+/* 1 if the bodies under the resting touches rest[0..nrest) gained, from s0 to s1, more than their
+ * kinetic energy again (contact forces do no work). mark: count bytes of zeros (left zero). */
+int lc_contact_energy_blew_up(const lc_world *w, const double *s0, const double *s1, const lc_touch *rest,
+                              int nrest, uint8_t *mark);
+/* 1 if the step from `backup` to w->state gained far more energy than its driving forces can give. */
+int lc_step_energy_blew_up(const lc_world *w, const double *backup, double dt, int started_deep);
 
 /* Stage timing (stage_timing.c): t0 = lc_stage_begin(w); ...; lc_stage_end(w, &w->last.time_x, t0). */
 double lc_stage_clock(void);
