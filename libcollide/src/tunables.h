@@ -16,6 +16,54 @@
  * both 0), the inelastic collapse the contact regime exists for. A settling block makes a handful. */
 #define LC_HANDOVER_EVENTS 8
 
+/* ---- the event regime (event_regime.c, event_crossings.c, event_projection.c) ------------------ */
+
+/* Most a body may turn (rad) within one collision-checked interval: vertex paths are tested as straight
+ * lines in the other body's frame, which holds while bodies turn little, so a fast spinner is checked
+ * over shorter trial intervals. */
+#define LC_MAX_TRIAL_ROTATION 0.25
+/* Most rotation-limited intervals in one step: an absurd spin must not split the step without end (the
+ * check is then coarser for that body). */
+#define LC_MAX_TRIALS 1024
+/* Most crossings one step may set aside as stalled (an impact at time 0 with nothing to do) before it
+ * stops looking for crossings at all; the pass keeps them in a fixed array of this size (fuzz finding
+ * 24: a sliver at 1e6 m/s with damping 1e9 stalled 65, docs/hardening.md). */
+#define LC_MAX_STALLED 64
+/* Sub-times at which the swept check samples a pair whose paths may stray from their chords (a vertex
+ * dipping into another body and out again within the interval, invisible to the end-point test); each
+ * sample costs an integration of the pair, or of the world for a coupled pair. */
+#define LC_SWEEP_SAMPLES 8
+/* Passes of the end-of-step projection: the linearised rotation leaves a second-order remainder after a
+ * deep correction (a sliver's corner millimetres in after an impact storm), and a few passes take it
+ * below round-off. */
+#define LC_PROJECTION_PASSES 16
+/* Overlap (m) a step may end with: round-off of the projection. Deeper after every pass, the step fails
+ * (forces far beyond what dt can resolve). */
+#define LC_OVERLAP_TOLERANCE 1e-9
+
+/* Most work one step may do before it is undone with LC_ERR_NUMERIC: force evaluations and serial
+ * impulse passes. A 210-box pyramid needs ~30 evaluations per step and the seed scene none; these
+ * are reached only by inputs such as a 1e6 kg and a 1e-300 kg body at 1e6 m/s, or a stiff spring
+ * anchored 1e6 m away, which would otherwise spend seconds on one step before failing anyway. */
+#ifndef LC_MAX_FORCE_EVALUATIONS_PER_STEP
+#define LC_MAX_FORCE_EVALUATIONS_PER_STEP 500000
+#endif
+#ifndef LC_MAX_SERIAL_ITERATIONS_PER_STEP
+#define LC_MAX_SERIAL_ITERATIONS_PER_STEP 50000
+#endif
+/* and the complementarity solves' work (lc_counters.solver_work), per body of the world: one force
+ * evaluation of four coincident decagons (a 120-row dense group) costs 150 of the settling scene's
+ * (20 blocks), so evaluations alone let such a step run 110 s to their cap (fuzz finding 32).
+ * Measured per body (bench/repro/solver_work_per_body.py): the hardest legitimate step, a box dropped
+ * onto a 78-box frictional pyramid, does 1.1e8 (10.5 s of CPU), the bench scenes at most 3e5; that
+ * input did 1.7e10 by the evaluation cap, and now stops at 1e9 after 3 s. */
+#ifndef LC_MAX_SOLVER_WORK_PER_BODY
+#define LC_MAX_SOLVER_WORK_PER_BODY 1000000000
+#endif
+/* The caps can be lowered at build time (-DLC_MAX_...=N, a plain decimal number, which the step's
+ * error messages quote): fuzz/run --engine-cap does so, so that the fuzzer does not spend seconds on
+ * each input that ends at a cap anyway. */
+
 /* ---- the contact regime (contact_regime.c) ---------------------------------------------------- */
 
 /* Islands of at most this many bodies (a body on static ones) have their stick-slip transitions and

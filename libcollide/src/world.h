@@ -164,6 +164,14 @@ static inline double lc_cross(lc_vec2 a, lc_vec2 b) { return a.x * b.y - a.y * b
 static inline lc_vec2 lc_wcross(double w, lc_vec2 r) { return lc_v(-w * r.y, w * r.x); }
 static inline lc_vec2 lc_rot(double c, double s, lc_vec2 a) { return lc_v(c * a.x - s * a.y, s * a.x + c * a.y); }
 static inline lc_vec2 lc_rot_inv(double c, double s, lc_vec2 a) { return lc_v(c * a.x + s * a.y, -s * a.x + c * a.y); }
+/* 1 if marked[row] != 0 for one of rows[0..n). */
+static inline int lc_any_marked(const uint8_t *marked, const int *rows, int n)
+{
+    int i;
+    for (i = 0; i < n; ++i)
+        if (marked[rows[i]]) return 1;
+    return 0;
+}
 
 /* ---- forces.c: accelerations from applied (non-contact) forces ---- */
 /* For rows[0..n): acc[row*3 + 0..2] = (ax, ay, alpha) from gravity, damping, thrusters, springs, external. */
@@ -276,6 +284,18 @@ int lc_integrate_rows(lc_world *w, const double *s0, double h, const int *rows, 
 int lc_resolve_impacts(lc_world *w, double *state, lc_touch *t, int n, int elastic);
 /* Approach speed (m/s) above which an impact of a pair of this elasticity bounces. */
 double lc_bounce_speed(const lc_world *w, double elasticity);
+
+/* ---- step.c ---- */
+/* The try at the step in progress, as the regimes see it: where it began (to undo it, or to weigh its
+ * energy against), and the rows an earlier try sent to the event regime. */
+typedef struct lc_step_try {
+    const double *start;         /* every row's state when the step began */
+    double time0;                /* the world's time then */
+    const uint8_t *force_event;  /* rows an earlier try of this step found the contact regime unable to keep apart */
+} lc_step_try;
+/* Undoes the step in progress (the state and time it began with, no contacts) and fails with s:
+ * "<what>; the step was undone". */
+lc_status lc_step_undo(lc_world *w, const lc_step_try *step, lc_status s, const char *what);
 
 /* ---- results.c ---- */
 /* Appends a contact of the step in progress (a touch at its current geometry). 0, or -1 without memory. */

@@ -1,0 +1,234 @@
+/* The event regime's detection: the vertices that entered another body during a trial interval, found
+ * by the end-point test on the broad phase's pairs and by the swept check on pairs whose paths may have
+ * dipped in and out again; crossings that are not impacts (stalled ones, a resting vertex's drift) are
+ * left out, and after an impact in free flight the crossings of bodies it did not move are kept. */
+#include <math.h>
+#include <string.h>
+#include "world.h"
+#include "event_crossings.h"
+#include "tunables.h"
+
+/* Key of a vertex against a body, for the hash table of drop_resting_drift. */
+static uint32_t vertex_key(const lc_world *w, int a, int vertex, int b)
+{
+    uint32_t h = 2166136261u;
+    h = (h ^ w->ids[a]) * 16777619u;
+    h = (h ^ (uint32_t)vertex) * 16777619u;
+    return (h ^ w->ids[b]) * 16777619u;
+}
+
+/* A crossing whose impact at time 0 had nothing to do (no point approaching: typically a resting point
+ * that the contact forces did not hold exactly across the trial interval, crossing its own gap) would
+ * stop time at that instant forever. Such a vertex is set aside for the rest of the step (the contact
+ * forces and the end-of-step projection hold it), while every other vertex is still checked. */
+static int drop_stalled(lc_world *w, const lc_crossing *stalled, int nstalled, int nc)
+{
+    lc_crossing *c = (lc_crossing *)w->b_cross.p;
+    int i, k, kept = 0;
+    for (i = 0; i < nc; ++i) {
+        int skip = 0;
+        for (k = 0; k < nstalled && !skip; ++k)
+            skip = stalled[k].a == c[i].a && stalled[k].b == c[i].b && stalled[k].vertex == c[i].vertex;
+        if (!skip) c[kept++] = c[i];
+    }
+    return kept;
+}
+
+/* A vertex held by a resting contact force can sink below its gap by what the force solver left
+ * unresolved (a large pile, where the iterative solve stops at its sweep limit, leaves ~1e-2 m/s^2,
+ * i.e. ~1e-6 m in a 1/60 s step). That is not an impact: the force still holds the vertex, and the
+ * end-of-step projection lifts it back to the gap without touching velocities. Stopping time at it
+ * would stop at every such vertex of the pile in turn, each stop re-solving the whole pile (a
+ * 1275-box pyramid: thousands per step). A resting vertex that ends deeper than contact_distance is
+ * more than solver residual and stays an impact. */
+static int drop_resting_drift(lc_world *w, const lc_touch *rest, int nrest, const double *s1, int nc)
+{
+    lc_crossing *c = (lc_crossing *)w->b_cross.p;
+    int size = 1, i, kept = 0;
+    int *table;
+    if (nrest == 0 || nc == 0) return nc;
+    while (size < 2 * nrest) size *= 2;
+    table = lc_buf_get(&w->b_rkeys, (size_t)size * sizeof(int));
+    if (table == NULL) return -1;
+    for (i = 0; i < size; ++i) table[i] = -1;
+    for (i = 0; i < nrest; ++i) {
+        uint32_t k = vertex_key(w, rest[i].a, rest[i].vertex, rest[i].b) & (uint32_t)(size - 1);
+        while (table[k] >= 0) k = (k + 1) & (uint32_t)(size - 1);
+        table[k] = i;
+    }
+    for (i = 0; i < nc; ++i) {
+        uint32_t k = vertex_key(w, c[i].a, c[i].vertex, c[i].b) & (uint32_t)(size - 1);
+        int resting = 0;
+        while (table[k] >= 0 && !resting) {
+            const lc_touch *r = &rest[table[k]];
+            resting = r->a == c[i].a && r->vertex == c[i].vertex && r->b == c[i].b;
+            k = (k + 1) & (uint32_t)(size - 1);
+        }
+        if (resting && lc_vertex_edge_gap(w, s1, c[i].a, c[i].vertex, c[i].b, c[i].edge) > -w->def.contact_distance)
+            continue;
+        c[kept++] = c[i];
+    }
+    return kept;
+}
+
+/* Crossings of the previous pass between two bodies the last impact did not touch, with their bracket
+ * moved to the new start (tmin later). One whose bracket ended before the new start is dropped. */
+static int keep_clean_crossings(lc_world *w, const uint8_t *dirty, double tmin)
+{
+    lc_crossing *c = (lc_crossing *)w->b_cross.p;
+    int i, kept = 0, nc = w->cross_count;
+    for (i = 0; i < nc; ++i) {
+        if (dirty[c[i].a] || dirty[c[i].b]) continue;
+        c[i].t_hi -= tmin;
+        if (!(c[i].t_hi > 0.0)) continue;
+        c[kept++] = c[i];
+    }
+    return kept;
+}
+
+/* How far a vertex of one body can stray, in the other's frame, from the straight chord between its
+ * positions at the ends of an interval of length h: turning by dtheta bends the path by r dtheta^2 / 8,
+ * and a change dv of the relative velocity by dv h / 8 (relative: two blocks falling side by side
+ * under gravity move on parallel parabolas, straight lines in each other's frame). */
+static double chord_deviation(const lc_world *w, const double *s0, const double *s1, double h, int a, int b)
+{
+    double turn = fabs(s1[a * 6 + SA] - s0[a * 6 + SA]) + fabs(s1[b * 6 + SA] - s0[b * 6 + SA]);
+    double dvx = (s1[a * 6 + SVX] - s0[a * 6 + SVX]) - (s1[b * 6 + SVX] - s0[b * 6 + SVX]);
+    double dvy = (s1[a * 6 + SVY] - s0[a * 6 + SVY]) - (s1[b * 6 + SVY] - s0[b * 6 + SVY]);
+    return turn * turn * (w->shape[a].radius + w->shape[b].radius) / 8.0 + hypot(dvx, dvy) * h / 8.0;
+}
+
+/* Distance between the bodies' bounding circles (negative when they overlap). */
+static double circle_gap(const lc_world *w, const double *s, int a, int b)
+{
+    return hypot(s[a * 6 + SX] - s[b * 6 + SX], s[a * 6 + SY] - s[b * 6 + SY]) - w->shape[a].radius - w->shape[b].radius;
+}
+
+/* Vertices that dip into another body and come back out within the interval are invisible to the
+ * end-point test. For pairs that end up closer than their chords can stray, the two bodies' motion is
+ * sampled at LC_SWEEP_SAMPLES sub-times and every sub-interval is tested; a crossing found there
+ * carries the sub-time by which it is inside as the upper end of its time-of-impact bracket.
+ * A coupled pair (touching others, or tied by a spring) moves with the whole world, whose sub-time
+ * states are computed once per interval and shared by every such pair: in a pile each of them costs
+ * a contact-force solve of the whole pile per integrator stage, and a settling 1275-box pyramid has
+ * hundreds of near pairs in one interval. */
+static int swept_check(lc_world *w, const double *s0, const double *s1, double h, const int *pairs, int np, int nc,
+                       const int *coupled, const int *all_rows, int n_all, lc_touch *rest, int nrest)
+{
+    size_t count6 = (size_t)w->count * 6, bytes = count6 * sizeof(double);
+    double *own[2], *world_at = NULL;
+    int have_world[LC_SWEEP_SAMPLES] = {0};
+    int p, k, i;
+    own[0] = own[1] = NULL;
+    for (p = 0; p < np; ++p) {
+        int a = pairs[2 * p], b = pairs[2 * p + 1], rows[2], nr = 0, have = 0, uncoupled;
+        double dev, sep0;
+        const double *prev, *cur;
+        for (i = 0; i < nc; ++i) {
+            const lc_crossing *c = &((const lc_crossing *)w->b_cross.p)[i];
+            if ((c->a == a && c->b == b) || (c->a == b && c->b == a)) have = 1;
+        }
+        /* the end-point test already bracketed this pair; if another vertex (a corner meeting a
+         * corner) dipped in before that crossing's time, the pair's time of impact finds it */
+        if (have) continue;
+        dev = chord_deviation(w, s0, s1, h, a, b);
+        /* a path that strays from its chord by less than a quarter of the contact gap can dip at most
+         * that far past what the end-point test sees: never into the other body (a settled pile) */
+        if (dev < 0.25 * w->def.contact_gap) continue;
+        /* bounding circles apart by more than the paths can stray, at both ends: nothing can dip in
+         * (the circles' distance is a lower bound of the bodies' distance, as the separation is) */
+        if (circle_gap(w, s0, a, b) > dev + w->def.contact_distance &&
+            circle_gap(w, s1, a, b) > dev + w->def.contact_distance)
+            continue;
+        if (lc_bounds_gap(w, s0, a, b) > dev + w->def.contact_distance &&
+            lc_bounds_gap(w, s1, a, b) > dev + w->def.contact_distance)
+            continue;
+        sep0 = lc_pair_separation(w, s0, a, b);
+        /* touching at the start: resting contacts or impacts already guard the pair */
+        if (sep0 < w->def.contact_distance) continue;
+        if (sep0 > dev + w->def.contact_distance && lc_pair_separation(w, s1, a, b) > dev + w->def.contact_distance)
+            continue;
+        if (!w->is_static[a]) rows[nr++] = a;
+        if (!w->is_static[b]) rows[nr++] = b;
+        uncoupled = !coupled[a] && !coupled[b];
+        prev = s0;
+        for (k = 1; k <= LC_SWEEP_SAMPLES; ++k) {
+            double tk = h * k / LC_SWEEP_SAMPLES;
+            int before = nc;
+            if (k == LC_SWEEP_SAMPLES) {
+                cur = s1;
+            } else if (uncoupled) {
+                double *dst;
+                if (own[0] == NULL) {
+                    own[0] = lc_buf_get(&w->b_sample0, bytes);
+                    own[1] = lc_buf_get(&w->b_sample1, bytes);
+                    if (!own[0] || !own[1]) return -1;
+                }
+                dst = own[k & 1];   /* prev is the other one (or s0) */
+                if (lc_integrate(w, s0, tk, rows, nr, NULL, 0, dst) != 0) return -1;
+                cur = dst;
+            } else {
+                /* the whole world advanced with its resting contacts, exactly as in the trial */
+                if (world_at == NULL) {
+                    world_at = lc_buf_get(&w->b_swept, (LC_SWEEP_SAMPLES - 1) * bytes);
+                    if (world_at == NULL) return -1;
+                }
+                if (!have_world[k]) {
+                    if (lc_integrate(w, s0, tk, all_rows, n_all, rest, nrest, world_at + (size_t)(k - 1) * count6) != 0)
+                        return -1;
+                    have_world[k] = 1;
+                }
+                cur = world_at + (size_t)(k - 1) * count6;
+            }
+            nc = lc_find_crossings(w, prev, cur, a, b, &w->b_cross, nc);
+            if (nc < 0) return -1;
+            if (nc > before) {
+                for (i = before; i < nc; ++i) ((lc_crossing *)w->b_cross.p)[i].t_hi = tk;
+                break;
+            }
+            prev = cur;
+        }
+    }
+    return nc;
+}
+
+int lc_event_crossings_find(lc_world *w, const lc_trial *tr, const lc_moved *moved, const lc_crossing *stalled,
+                            int nstalled, lc_crossing **out)
+{
+    int np, nc = 0, nkept = 0, i, *coupled;
+    const int *pairs;
+    if (moved != NULL) {
+        nc = nkept = keep_clean_crossings(w, moved->marked, moved->since);
+        np = lc_broad_phase_of(w, tr->s0, tr->s1, w->def.contact_distance, moved->marked, moved->rows, moved->n,
+                               &w->b_pairs);
+    } else {
+        np = lc_broad_phase(w, tr->s0, tr->s1, w->def.contact_distance, &w->b_pairs);
+    }
+    if (np < 0) return -1;
+    pairs = (const int *)w->b_pairs.p;
+    for (i = 0; i < np && nstalled <= LC_MAX_STALLED; ++i) {
+        nc = lc_find_crossings(w, tr->s0, tr->s1, pairs[2 * i], pairs[2 * i + 1], &w->b_cross, nc);
+        if (nc < 0) return -1;
+    }
+    /* past LC_MAX_STALLED the list is full (and no crossing is looked for): only its entries */
+    nc = drop_stalled(w, stalled, nstalled < LC_MAX_STALLED ? nstalled : LC_MAX_STALLED, nc);
+    nc = drop_resting_drift(w, tr->rest, tr->nrest, tr->s1, nc);
+    if (nc < 0) return -1;
+    /* a body touching nothing and tied by no spring to another body moves on its own: its
+     * time-of-impact evaluations (and swept samples) need only the two bodies */
+    coupled = lc_buf_get(&w->b_coupled, (size_t)w->count * sizeof(int));
+    if (coupled == NULL) return -1;
+    memset(coupled, 0, (size_t)w->count * sizeof(int));
+    for (i = 0; i < tr->nrest; ++i) coupled[tr->rest[i].a] = coupled[tr->rest[i].b] = 1;
+    for (i = 0; i < w->spring_count; ++i)
+        if (w->springs[i].def.body_b != LC_WORLD_ANCHOR) {
+            coupled[lc_world_body_index(w, w->springs[i].def.body_a)] = 1;
+            coupled[lc_world_body_index(w, w->springs[i].def.body_b)] = 1;
+        }
+    for (i = nkept; i < nc; ++i) ((lc_crossing *)w->b_cross.p)[i].t_hi = tr->h;
+    nc = swept_check(w, tr->s0, tr->s1, tr->h, pairs, np, nc, coupled, tr->rows, tr->nrows, tr->rest, tr->nrest);
+    if (nc < 0) return -1;
+    *out = (lc_crossing *)w->b_cross.p;
+    w->cross_count = nc;
+    return nc;
+}

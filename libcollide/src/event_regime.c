@@ -1,0 +1,312 @@
+/* The event regime (docs/contact_regime.md), the engine's original exact path: integrate a trial
+ * interval, look for vertices that entered another body, back up to the earliest time of impact, apply
+ * the impulses there, and continue with the rest of the step; time is never dropped. Resting contact is
+ * held by contact forces during the intervals and by the end-of-step projection after them. Its parts:
+ * the touches (event_touches.c), the detection (event_crossings.c), the touch islands a time-of-impact
+ * search advances (touch_islands.c) and the projection (event_projection.c). */
+#include <math.h>
+#include <string.h>
+#include "world.h"
+#include "event_regime.h"
+#include "event_crossings.h"
+#include "event_projection.h"
+#include "event_touches.h"
+#include "islands.h"
+#include "regime.h"
+#include "touch_islands.h"
+#include "tunables.h"
+
+#define LC_STRINGIFY_(x) #x
+#define LC_STRINGIFY(x) LC_STRINGIFY_(x)
+
+lc_status lc_event_advance(lc_world *w, const lc_step_try *step, double dt, double t0, const int *event_rows, int nrows,
+                           int *marks_known, int *handover, double *t_handover)
+{
+    size_t bytes;
+    double *s0, *s1, *scratch, remaining;
+    int *rows, i, events = 0, nstalled = 0, nrest = 0, passes = 0, persisting = -1, last_impact_body = -1;
+    int dissipative_events = 0;
+    int *drows, ndirty = 0, local_next = 0, body_springs = 0, started_deep = 0;
+    uint8_t *dirty;
+    double last_tmin = 0.0, trial_left = 0.0, ts;
+    lc_crossing stalled[LC_MAX_STALLED];
+    bytes = (size_t)(w->count > 0 ? w->count : 1) * 6 * sizeof(double);
+    s0 = lc_buf_get(&w->b_state0, bytes);
+    s1 = lc_buf_get(&w->b_state1, bytes);
+    scratch = lc_buf_get(&w->b_step_scratch, bytes);
+    rows = lc_buf_get(&w->b_rows, (size_t)(w->count > 0 ? w->count : 1) * sizeof(int));
+    if (!s0 || !s1 || !scratch || !rows) return lc_fail(w, LC_ERR_NO_MEMORY, "out of memory in step");
+    memcpy(rows, event_rows, (size_t)nrows * sizeof(int));
+    dirty = lc_buf_get(&w->b_dirty, (size_t)w->count);
+    drows = lc_buf_get(&w->b_drows, (size_t)w->count * sizeof(int));
+    if (!dirty || !drows) return lc_fail(w, LC_ERR_NO_MEMORY, "out of memory in step");
+    memset(dirty, 0, (size_t)w->count);
+    for (i = 0; i < w->spring_count; ++i)
+        if (w->springs[i].def.body_b != LC_WORLD_ANCHOR) body_springs = 1;
+
+    remaining = dt;
+    while (remaining > 0.0) {
+        int nc, best = -1, nimp, hits, by_pair = 0;
+        lc_touch_islands ti;
+        double tmin = remaining;
+        lc_crossing *cross;
+        lc_touch *rest;
+
+        double trial = remaining, wmax = 0.0;
+        int events_before = events, local = 0, can_reuse;
+        /* after an impact in free flight only the impact's bodies can have come to touch anything:
+         * every other pair was apart (nothing rested) and moved without an impact */
+        ts = lc_stage_begin(w);
+        if (local_next && !body_springs)
+            nrest = lc_event_resting(w, w->state, &events, dirty, drows, ndirty, passes > 0, &started_deep, &persisting);
+        else
+            nrest = lc_event_resting(w, w->state, &events, NULL, NULL, 0, passes > 0, &started_deep, &persisting);
+        lc_stage_end(w, &w->last.time_detection, ts);
+        if (nrest == -2)
+            return lc_step_undo(w, step, LC_ERR_NUMERIC,
+                                "a body passed deep into another within the step (speeds or spins beyond what dt can resolve)");
+        if (nrest < 0) goto oom;
+        rest = (lc_touch *)w->b_touch.p;
+        /* from here on that touch persists, which the contact regime advances (regime.h); so does a burst
+         * of impacts (inelastic collapse: a block bouncing ever lower, e^k, where no speed threshold
+         * stops it) */
+        if (handover != NULL && persisting < 0 && dissipative_events >= LC_HANDOVER_EVENTS) persisting = last_impact_body;
+        if (handover != NULL && persisting >= 0) {
+            lc_island isl = lc_islands_get(w->islands, lc_islands_of(w->islands, persisting));
+            if (!lc_regime_too_fast(w, &isl, remaining) && !lc_any_marked(step->force_event, isl.rows, isl.nrows)) {
+                *handover = lc_islands_of(w->islands, persisting);
+                *t_handover = dt - remaining;
+                return LC_OK;
+            }
+        }
+        memcpy(s0, w->state, (size_t)w->count * 6 * sizeof(double));
+        /* Vertex paths are tested as straight lines in the other body's frame; that holds while bodies
+         * turn little, so a fast spinner is checked over shorter trial intervals. */
+        for (i = 0; i < nrows; ++i) wmax = fmax(wmax, fabs(s0[rows[i] * 6 + SW]));
+        if (wmax * trial > LC_MAX_TRIAL_ROTATION) trial = LC_MAX_TRIAL_ROTATION / wmax;
+        /* an absurd spin must not split the step without end: at most LC_MAX_TRIALS rotation-limited
+         * intervals (the check is then coarser for that body) */
+        if (trial < dt / LC_MAX_TRIALS) trial = fmin(remaining, dt / LC_MAX_TRIALS);
+        /* the rest of the previous trial, if the turning limit allows it: then its end is the same */
+        can_reuse = local_next && trial_left > 0.0 && trial_left <= trial;
+        if (can_reuse) trial = trial_left;
+        if (++passes > w->def.max_events_per_step + 2 * LC_MAX_TRIALS)
+            return lc_step_undo(w, step, LC_ERR_NUMERIC,
+                                "the step needed more than max_events_per_step impacts and intervals (stiff forces or extreme speeds?)");
+        if (w->last.force_evaluations > LC_MAX_FORCE_EVALUATIONS_PER_STEP ||
+            w->last.serial_iterations > LC_MAX_SERIAL_ITERATIONS_PER_STEP)
+            return lc_step_undo(w, step, LC_ERR_NUMERIC,
+                                "the step needed more than " LC_STRINGIFY(LC_MAX_FORCE_EVALUATIONS_PER_STEP)
+                                " force evaluations or " LC_STRINGIFY(LC_MAX_SERIAL_ITERATIONS_PER_STEP)
+                                " serial impulse passes (stiff forces or extreme speeds?)");
+        if ((double)w->last.solver_work > (double)LC_MAX_SOLVER_WORK_PER_BODY * (double)w->count)
+            return lc_step_undo(w, step, LC_ERR_NUMERIC,
+                                "the step's contact and impulse solves needed more than " LC_STRINGIFY(LC_MAX_SOLVER_WORK_PER_BODY)
+                                " matrix entries per body (lc_counters.solver_work; bodies piled onto one spot?)");
+        /* After an impact in free flight (nothing resting, no spring between bodies, the same trial
+         * end), only the bodies of that impact move differently: every other body keeps its trial
+         * path to the previous trial's end, and the crossings found between two such bodies stay
+         * valid. Then only the impact's bodies are re-advanced, to that same end, and only their pairs
+         * are tested again, instead of the whole world. */
+        local = can_reuse && nrest == 0 && events == events_before && !body_springs;
+        ts = lc_stage_begin(w);
+        if (local) {
+            if (lc_integrate_rows(w, s0, trial, drows, ndirty, rest, 0, scratch) != 0) goto oom;
+            for (i = 0; i < ndirty; ++i) memcpy(&s1[drows[i] * 6], &scratch[drows[i] * 6], 6 * sizeof(double));
+        } else {
+            if (lc_integrate(w, s0, trial, rows, nrows, rest, nrest, s1) != 0) goto oom;
+        }
+        lc_stage_end(w, &w->last.time_integration, ts);
+        for (i = 0; i < nrows; ++i) {
+            int k;
+            for (k = 0; k < 6; ++k)
+                if (!isfinite(s1[rows[i] * 6 + k]))
+                    return lc_step_undo(w, step, LC_ERR_NUMERIC,
+                                        "integration produced a non-finite state (forces too stiff for dt?)");
+        }
+        if (nrest > 0) {
+            uint8_t *mark = lc_buf_get(&w->b_emark, (size_t)w->count);
+            if (mark == NULL) goto oom;
+            memset(mark, 0, (size_t)w->count);
+            if (lc_contact_energy_blew_up(w, s0, s1, rest, nrest, mark))
+                return lc_step_undo(w, step, LC_ERR_NUMERIC,
+                                    "contact forces gained energy (speeds or spins beyond what dt can resolve)");
+        }
+        if (lc_event_keep_warm(w, rest, nrest) != 0) goto oom;
+        tmin = trial;
+
+        /* vertices that entered another body during the trial step */
+        {
+            lc_trial tr;
+            lc_moved moved;
+            tr.s0 = s0;
+            tr.s1 = s1;
+            tr.h = trial;
+            tr.rows = rows;
+            tr.nrows = nrows;
+            tr.rest = rest;
+            tr.nrest = nrest;
+            moved.marked = dirty;
+            moved.rows = drows;
+            moved.n = ndirty;
+            moved.since = last_tmin;
+            ts = lc_stage_begin(w);
+            nc = lc_event_crossings_find(w, &tr, local ? &moved : NULL, stalled, nstalled, &cross);
+            lc_stage_end(w, &w->last.time_detection, ts);
+            if (nc < 0) goto oom;
+        }
+        /* earliest time of impact; a crossing whose gap is still open at the best time so far is later.
+         * Each evaluation advances only the islands of the crossing's two bodies; those islands at
+         * the best time so far are kept for the next crossing of the same islands (a pile is one
+         * island, and each of its integrations solves the whole pile's contact forces). */
+        ts = lc_stage_begin(w);
+        if (nc > 0 && lc_touch_islands_build(w, rows, nrows, rest, nrest, &ti) != 0) goto oom;
+        {
+            double *at_best = NULL, at_t = -1.0;
+            int at_ia = -2, at_ib = -2;
+            for (i = 0; i < nc && !(best >= 0 && tmin == 0.0); ++i) {
+                double tau;
+                const int *erows;
+                int nerows, nerest;
+                lc_touch *erest;
+                if (lc_touch_islands_of(w, &ti, cross[i].a, cross[i].b, &erows, &nerows, &erest, &nerest) != 0) goto oom;
+                if (best >= 0) {
+                    double g;
+                    int ia = ti.of[cross[i].a], ib = ti.of[cross[i].b];
+                    if (at_best == NULL && (at_best = lc_buf_get(&w->b_sample0, bytes)) == NULL) goto oom;
+                    if (at_t != tmin || at_ia != ia || at_ib != ib) {
+                        if (lc_integrate(w, s0, tmin, erows, nerows, erest, nerest, at_best) != 0) goto oom;
+                        at_t = tmin;
+                        at_ia = ia;
+                        at_ib = ib;
+                    }
+                    g = lc_vertex_edge_gap(w, at_best, cross[i].a, cross[i].vertex, cross[i].b, cross[i].edge);
+                    if (g > w->def.contact_gap) continue;
+                }
+                tau = lc_time_of_impact(w, s0, fmin(tmin, cross[i].t_hi), &cross[i], erows, nerows, erest, nerest,
+                                        scratch);
+                if (tau < 0.0) continue;
+                if (best < 0 || tau < tmin) { tmin = tau; best = i; }
+            }
+        }
+        lc_stage_end(w, &w->last.time_toi_search, ts);
+        if (best < 0) {
+            local_next = 0;
+            memcpy(w->state, s1, (size_t)w->count * 6 * sizeof(double));
+            remaining -= trial;
+            if (remaining < 1e-14 * dt) remaining = 0.0;
+            w->time = t0 + (dt - remaining);
+            continue;
+        }
+
+        ts = lc_stage_begin(w);
+        if (tmin > 0.0) {
+            int ba = cross[best].a, bb = cross[best].b;
+            if (lc_integrate_rows(w, s0, tmin, rows, nrows, rest, nrest, w->state) != 0) goto oom;
+            /* another vertex of the pair (corner against corner) already inside, deeper than any
+             * crossing test can see from here on: the pair met earlier, find when */
+            if (lc_pair_separation(w, w->state, ba, bb) < -0.5 * w->def.contact_gap &&
+                lc_pair_separation(w, s0, ba, bb) > w->def.contact_gap) {
+                const int *erows;
+                int nerows, nerest;
+                lc_touch *erest;
+                double t2;
+                if (lc_touch_islands_of(w, &ti, ba, bb, &erows, &nerows, &erest, &nerest) != 0) goto oom;
+                lc_stage_end(w, &w->last.time_integration, ts);
+                ts = lc_stage_begin(w);
+                t2 = lc_pair_time_of_impact(w, s0, tmin, ba, bb, erows, nerows, erest, nerest, scratch);
+                lc_stage_end(w, &w->last.time_toi_search, ts);
+                ts = lc_stage_begin(w);
+                if (t2 < 0.0) goto oom;
+                tmin = t2;
+                by_pair = 1;
+                if (lc_integrate_rows(w, s0, tmin, rows, nrows, rest, nrest, w->state) != 0) goto oom;
+            }
+        } else {
+            memcpy(w->state, s0, (size_t)w->count * 6 * sizeof(double));
+        }
+        lc_stage_end(w, &w->last.time_integration, ts);
+        remaining -= tmin;
+        w->time = t0 + (dt - remaining);
+        if (remaining < 1e-14 * dt) remaining = 0.0;
+
+        ts = lc_stage_begin(w);
+        nimp = lc_event_impact_group(w, w->state, &cross[best], by_pair);
+        if (nimp < 0) goto oom;
+        /* past max_events_per_step (an impact storm: extreme speeds in a small box, a jam at e > 0)
+         * every further impact is inelastic, which ends the storm; the pass cap above still bounds it */
+        hits = lc_resolve_impacts(w, w->state, (lc_touch *)w->b_impact.p, nimp, events < w->def.max_events_per_step);
+        if (hits < 0) goto oom;
+        {
+            lc_touch *t = (lc_touch *)w->b_impact.p;
+            int dissipative = 0;
+            for (i = 0; i < nimp; ++i)
+                if (t[i].value > 0.0) {
+                    w->last.impulses++;
+                    if (lc_push_contact(w, &t[i], LC_CONTACT_COLLISION) != 0) goto oom;
+                    if (t[i].elasticity < 1.0) {
+                        dissipative = 1;
+                        last_impact_body = w->is_static[t[i].a] ? t[i].b : t[i].a;
+                    }
+                }
+            dissipative_events += dissipative;
+        }
+        lc_stage_end(w, &w->last.time_impulses, ts);
+        w->last.collisions++;
+        events++;
+        {
+            /* the impact's bodies are the ones whose paths changed (see `local` above) */
+            lc_touch *t = (lc_touch *)w->b_impact.p;
+            for (i = 0; i < ndirty; ++i) dirty[drows[i]] = 0;
+            ndirty = 0;
+            for (i = 0; i < nimp; ++i) {
+                int ab[2], q;
+                ab[0] = t[i].a;
+                ab[1] = t[i].b;
+                for (q = 0; q < 2; ++q)
+                    if (!w->is_static[ab[q]] && !dirty[ab[q]]) { dirty[ab[q]] = 1; drows[ndirty++] = ab[q]; }
+            }
+            local_next = nrest == 0;
+            trial_left = trial - tmin;
+            last_tmin = tmin;
+        }
+        if (hits == 0 && tmin == 0.0) {
+            if (nstalled < LC_MAX_STALLED) stalled[nstalled] = cross[best];
+            nstalled++;
+        }
+    }
+    if (remaining == 0.0) w->time = t0 + dt;
+    if (handover != NULL) *handover = -1;
+    if (lc_step_energy_blew_up(w, step->start, dt, started_deep))
+        return lc_step_undo(w, step, LC_ERR_NUMERIC,
+                            "the step gained far more energy than its external forces and thrusters can give "
+                            "(speeds or spins beyond what dt can resolve)");
+    {
+        int pr;
+        ts = lc_stage_begin(w);
+        pr = lc_event_project(w);
+        lc_stage_end(w, &w->last.time_projection, ts);
+        if (pr < 0) goto oom;
+        if (pr > 0)
+            return lc_step_undo(w, step, LC_ERR_NUMERIC,
+                                "bodies still overlap after the end-of-step projection (forces far too large for dt?)");
+    }
+
+    /* resting contacts at the end of the step, with the forces of the last evaluation */
+    {
+        lc_touch *rest = (lc_touch *)w->b_touch.p;
+        for (i = 0; i < nrest; ++i) {
+            lc_touch t = rest[i];
+            lc_touch_update(w, w->state, &t);
+            if (lc_push_contact(w, &t, LC_CONTACT_RESTING) != 0) goto oom;
+        }
+    }
+    /* what the event rows rest on at the end, for the next step's regime (the projection's last search
+     * was at the end state when it kept its touches) */
+    for (i = 0; i < nrows; ++i) w->rests_dissipative[rows[i]] = 0;
+    *marks_known = w->end_touch_count >= 0 || nrows == 0;
+    if (w->end_touch_count >= 0) lc_regime_mark(w, (const lc_touch *)w->b_end_touches.p, w->end_touch_count);
+    return LC_OK;
+oom:
+    return lc_step_undo(w, step, LC_ERR_NO_MEMORY, "out of memory during the step");
+}

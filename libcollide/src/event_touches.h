@@ -1,0 +1,26 @@
+/* The event regime's touches (event_touches.c): the resting set of a pass, the group an impact acts on,
+ * and the whole-world search, which reuses the touches the last step's projection found when nothing
+ * has moved or changed since. */
+#ifndef LC_EVENT_TOUCHES_H
+#define LC_EVENT_TOUCHES_H
+
+#include "world.h"
+
+/* Touches between all near pairs at `state` with gap < contact_distance, into buf from 0. Returns the
+ * count, or -1 without memory. */
+int lc_event_gather_touches(lc_world *w, const double *state, lc_buf *buf);
+/* The resting set at `state` (into w->b_touch), warm-started from the last pass's forces: between all
+ * near pairs, or (list != NULL) only the pairs with one of the listed bodies (marked[row] != 0). Touches
+ * inside the gap that still approach are resolved first as one impact (++*impacts). mid_step: not the
+ * step's first pass. *started_deep is set when the step starts with a point deep inside another body;
+ * *persisting is a body on a dissipative touch at rest (the contact regime's), or -1. Returns the
+ * count, -1 without memory, or -2 when a point passed deep into another body within the step. */
+int lc_event_resting(lc_world *w, double *state, int *impacts, const uint8_t *marked, const int *list, int nlist,
+                     int mid_step, int *started_deep, int *persisting);
+/* Keeps a pass's resting touches and their forces for the next pass's warm start. 0, or -1. */
+int lc_event_keep_warm(lc_world *w, const lc_touch *t, int n);
+/* The touches an impact at crossing c acts on (into w->b_impact): every touch of the group of bodies
+ * joined by touches to c's two, or (by_pair) that pair's own. Returns the count, or -1. */
+int lc_event_impact_group(lc_world *w, const double *state, const lc_crossing *c, int by_pair);
+
+#endif
