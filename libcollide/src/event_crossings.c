@@ -3,10 +3,35 @@
  * dipped in and out again; crossings that are not impacts (stalled ones, a resting vertex's drift) are
  * left out, and after an impact in free flight the crossings of bodies it did not move are kept. */
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 #include "world.h"
 #include "event_crossings.h"
 #include "tunables.h"
+
+struct lc_event_crossings {
+    lc_buf pairs;             /* the broad phase's pairs of the interval */
+    lc_buf cross;             /* the crossings (count of them after the last search) */
+    int count;
+    lc_buf coupled, keys;     /* bodies that touch another or are tied by a spring; drop_resting_drift's table */
+    lc_buf sample0, sample1;  /* the swept check: an uncoupled pair's states at two sub-times */
+    lc_buf samples;           /* and the whole world's at every sub-time */
+};
+
+lc_event_crossings *lc_event_crossings_create(void) { return calloc(1, sizeof(lc_event_crossings)); }
+
+void lc_event_crossings_destroy(lc_event_crossings *ec)
+{
+    if (ec == NULL) return;
+    lc_buf_free(&ec->pairs);
+    lc_buf_free(&ec->cross);
+    lc_buf_free(&ec->coupled);
+    lc_buf_free(&ec->keys);
+    lc_buf_free(&ec->sample0);
+    lc_buf_free(&ec->sample1);
+    lc_buf_free(&ec->samples);
+    free(ec);
+}
 
 /* Key of a vertex against a body, for the hash table of drop_resting_drift. */
 static uint32_t vertex_key(const lc_world *w, int a, int vertex, int b)
@@ -21,9 +46,9 @@ static uint32_t vertex_key(const lc_world *w, int a, int vertex, int b)
  * that the contact forces did not hold exactly across the trial interval, crossing its own gap) would
  * stop time at that instant forever. Such a vertex is set aside for the rest of the step (the contact
  * forces and the end-of-step projection hold it), while every other vertex is still checked. */
-static int drop_stalled(lc_world *w, const lc_crossing *stalled, int nstalled, int nc)
+static int drop_stalled(lc_event_crossings *ec, const lc_crossing *stalled, int nstalled, int nc)
 {
-    lc_crossing *c = (lc_crossing *)w->b_cross.p;
+    lc_crossing *c = (lc_crossing *)ec->cross.p;
     int i, k, kept = 0;
     for (i = 0; i < nc; ++i) {
         int skip = 0;
@@ -41,14 +66,15 @@ static int drop_stalled(lc_world *w, const lc_crossing *stalled, int nstalled, i
  * would stop at every such vertex of the pile in turn, each stop re-solving the whole pile (a
  * 1275-box pyramid: thousands per step). A resting vertex that ends deeper than contact_distance is
  * more than solver residual and stays an impact. */
-static int drop_resting_drift(lc_world *w, const lc_touch *rest, int nrest, const double *s1, int nc)
+static int drop_resting_drift(const lc_world *w, lc_event_crossings *ec, const lc_touch *rest, int nrest, const double *s1,
+                              int nc)
 {
-    lc_crossing *c = (lc_crossing *)w->b_cross.p;
+    lc_crossing *c = (lc_crossing *)ec->cross.p;
     int size = 1, i, kept = 0;
     int *table;
     if (nrest == 0 || nc == 0) return nc;
     while (size < 2 * nrest) size *= 2;
-    table = lc_buf_get(&w->b_rkeys, (size_t)size * sizeof(int));
+    table = lc_buf_get(&ec->keys, (size_t)size * sizeof(int));
     if (table == NULL) return -1;
     for (i = 0; i < size; ++i) table[i] = -1;
     for (i = 0; i < nrest; ++i) {
@@ -73,10 +99,10 @@ static int drop_resting_drift(lc_world *w, const lc_touch *rest, int nrest, cons
 
 /* Crossings of the previous pass between two bodies the last impact did not touch, with their bracket
  * moved to the new start (tmin later). One whose bracket ended before the new start is dropped. */
-static int keep_clean_crossings(lc_world *w, const uint8_t *dirty, double tmin)
+static int keep_clean_crossings(lc_event_crossings *ec, const uint8_t *dirty, double tmin)
 {
-    lc_crossing *c = (lc_crossing *)w->b_cross.p;
-    int i, kept = 0, nc = w->cross_count;
+    lc_crossing *c = (lc_crossing *)ec->cross.p;
+    int i, kept = 0, nc = ec->count;
     for (i = 0; i < nc; ++i) {
         if (dirty[c[i].a] || dirty[c[i].b]) continue;
         c[i].t_hi -= tmin;
@@ -112,8 +138,9 @@ static double circle_gap(const lc_world *w, const double *s, int a, int b)
  * states are computed once per interval and shared by every such pair: in a pile each of them costs
  * a contact-force solve of the whole pile per integrator stage, and a settling 1275-box pyramid has
  * hundreds of near pairs in one interval. */
-static int swept_check(lc_world *w, const double *s0, const double *s1, double h, const int *pairs, int np, int nc,
-                       const int *coupled, const int *all_rows, int n_all, lc_touch *rest, int nrest)
+static int swept_check(lc_world *w, lc_event_crossings *ec, const double *s0, const double *s1, double h,
+                       const int *pairs, int np, int nc, const int *coupled, const int *all_rows, int n_all,
+                       lc_touch *rest, int nrest)
 {
     size_t count6 = (size_t)w->count * 6, bytes = count6 * sizeof(double);
     double *own[2], *world_at = NULL;
@@ -125,7 +152,7 @@ static int swept_check(lc_world *w, const double *s0, const double *s1, double h
         double dev, sep0;
         const double *prev, *cur;
         for (i = 0; i < nc; ++i) {
-            const lc_crossing *c = &((const lc_crossing *)w->b_cross.p)[i];
+            const lc_crossing *c = &((const lc_crossing *)ec->cross.p)[i];
             if ((c->a == a && c->b == b) || (c->a == b && c->b == a)) have = 1;
         }
         /* the end-point test already bracketed this pair; if another vertex (a corner meeting a
@@ -160,8 +187,8 @@ static int swept_check(lc_world *w, const double *s0, const double *s1, double h
             } else if (uncoupled) {
                 double *dst;
                 if (own[0] == NULL) {
-                    own[0] = lc_buf_get(&w->b_sample0, bytes);
-                    own[1] = lc_buf_get(&w->b_sample1, bytes);
+                    own[0] = lc_buf_get(&ec->sample0, bytes);
+                    own[1] = lc_buf_get(&ec->sample1, bytes);
                     if (!own[0] || !own[1]) return -1;
                 }
                 dst = own[k & 1];   /* prev is the other one (or s0) */
@@ -170,7 +197,7 @@ static int swept_check(lc_world *w, const double *s0, const double *s1, double h
             } else {
                 /* the whole world advanced with its resting contacts, exactly as in the trial */
                 if (world_at == NULL) {
-                    world_at = lc_buf_get(&w->b_swept, (LC_SWEEP_SAMPLES - 1) * bytes);
+                    world_at = lc_buf_get(&ec->samples, (LC_SWEEP_SAMPLES - 1) * bytes);
                     if (world_at == NULL) return -1;
                 }
                 if (!have_world[k]) {
@@ -180,10 +207,10 @@ static int swept_check(lc_world *w, const double *s0, const double *s1, double h
                 }
                 cur = world_at + (size_t)(k - 1) * count6;
             }
-            nc = lc_find_crossings(w, prev, cur, a, b, &w->b_cross, nc);
+            nc = lc_find_crossings(w, prev, cur, a, b, &ec->cross, nc);
             if (nc < 0) return -1;
             if (nc > before) {
-                for (i = before; i < nc; ++i) ((lc_crossing *)w->b_cross.p)[i].t_hi = tk;
+                for (i = before; i < nc; ++i) ((lc_crossing *)ec->cross.p)[i].t_hi = tk;
                 break;
             }
             prev = cur;
@@ -192,31 +219,31 @@ static int swept_check(lc_world *w, const double *s0, const double *s1, double h
     return nc;
 }
 
-int lc_event_crossings_find(lc_world *w, const lc_trial *tr, const lc_moved *moved, const lc_crossing *stalled,
-                            int nstalled, lc_crossing **out)
+int lc_event_crossings_find(lc_world *w, lc_event_crossings *ec, const lc_trial *tr, const lc_moved *moved,
+                            const lc_crossing *stalled, int nstalled, lc_crossing **out)
 {
     int np, nc = 0, nkept = 0, i, *coupled;
     const int *pairs;
     if (moved != NULL) {
-        nc = nkept = keep_clean_crossings(w, moved->marked, moved->since);
+        nc = nkept = keep_clean_crossings(ec, moved->marked, moved->since);
         np = lc_broad_phase_of(w, tr->s0, tr->s1, w->def.contact_distance, moved->marked, moved->rows, moved->n,
-                               &w->b_pairs);
+                               &ec->pairs);
     } else {
-        np = lc_broad_phase(w, tr->s0, tr->s1, w->def.contact_distance, &w->b_pairs);
+        np = lc_broad_phase(w, tr->s0, tr->s1, w->def.contact_distance, &ec->pairs);
     }
     if (np < 0) return -1;
-    pairs = (const int *)w->b_pairs.p;
+    pairs = (const int *)ec->pairs.p;
     for (i = 0; i < np && nstalled <= LC_MAX_STALLED; ++i) {
-        nc = lc_find_crossings(w, tr->s0, tr->s1, pairs[2 * i], pairs[2 * i + 1], &w->b_cross, nc);
+        nc = lc_find_crossings(w, tr->s0, tr->s1, pairs[2 * i], pairs[2 * i + 1], &ec->cross, nc);
         if (nc < 0) return -1;
     }
     /* past LC_MAX_STALLED the list is full (and no crossing is looked for): only its entries */
-    nc = drop_stalled(w, stalled, nstalled < LC_MAX_STALLED ? nstalled : LC_MAX_STALLED, nc);
-    nc = drop_resting_drift(w, tr->rest, tr->nrest, tr->s1, nc);
+    nc = drop_stalled(ec, stalled, nstalled < LC_MAX_STALLED ? nstalled : LC_MAX_STALLED, nc);
+    nc = drop_resting_drift(w, ec, tr->rest, tr->nrest, tr->s1, nc);
     if (nc < 0) return -1;
     /* a body touching nothing and tied by no spring to another body moves on its own: its
      * time-of-impact evaluations (and swept samples) need only the two bodies */
-    coupled = lc_buf_get(&w->b_coupled, (size_t)w->count * sizeof(int));
+    coupled = lc_buf_get(&ec->coupled, (size_t)w->count * sizeof(int));
     if (coupled == NULL) return -1;
     memset(coupled, 0, (size_t)w->count * sizeof(int));
     for (i = 0; i < tr->nrest; ++i) coupled[tr->rest[i].a] = coupled[tr->rest[i].b] = 1;
@@ -225,10 +252,10 @@ int lc_event_crossings_find(lc_world *w, const lc_trial *tr, const lc_moved *mov
             coupled[lc_world_body_index(w, w->springs[i].def.body_a)] = 1;
             coupled[lc_world_body_index(w, w->springs[i].def.body_b)] = 1;
         }
-    for (i = nkept; i < nc; ++i) ((lc_crossing *)w->b_cross.p)[i].t_hi = tr->h;
-    nc = swept_check(w, tr->s0, tr->s1, tr->h, pairs, np, nc, coupled, tr->rows, tr->nrows, tr->rest, tr->nrest);
+    for (i = nkept; i < nc; ++i) ((lc_crossing *)ec->cross.p)[i].t_hi = tr->h;
+    nc = swept_check(w, ec, tr->s0, tr->s1, tr->h, pairs, np, nc, coupled, tr->rows, tr->nrows, tr->rest, tr->nrest);
     if (nc < 0) return -1;
-    *out = (lc_crossing *)w->b_cross.p;
-    w->cross_count = nc;
+    *out = (lc_crossing *)ec->cross.p;
+    ec->count = nc;
     return nc;
 }

@@ -4,6 +4,11 @@
 
 #include "world.h"
 
+typedef struct lc_event_crossings lc_event_crossings;   /* owned by the event regime */
+
+lc_event_crossings *lc_event_crossings_create(void);
+void lc_event_crossings_destroy(lc_event_crossings *ec);
+
 /* A trial interval: rows[0..nrows) advanced from s0 over h to s1, with the resting touches rest[0..nrest)
  * held by contact forces. */
 typedef struct lc_trial {
@@ -23,12 +28,12 @@ typedef struct lc_moved {
     double since;
 } lc_moved;
 
-/* The crossings of the trial interval (each with t_hi, a time by which its vertex is inside), into *out:
- * of every pair, or (moved != NULL: after an impact in free flight, to the same interval's end) of the
- * pairs with a moved body, the previous search's others kept. Crossings of the first
- * min(nstalled, LC_MAX_STALLED) entries of `stalled` are left out; past LC_MAX_STALLED none is looked
- * for. Returns the count, or -1 without memory. */
-int lc_event_crossings_find(lc_world *w, const lc_trial *tr, const lc_moved *moved, const lc_crossing *stalled,
-                            int nstalled, lc_crossing **out);
+/* The crossings of the trial interval (each with t_hi, a time by which its vertex is inside), into *out
+ * (valid until the next search): of every pair, or (moved != NULL: after an impact in free flight, to
+ * the same interval's end) of the pairs with a moved body, the previous search's others kept. Crossings
+ * of the first min(nstalled, LC_MAX_STALLED) entries of `stalled` are left out; past LC_MAX_STALLED none
+ * is looked for. Returns the count, or -1 without memory. */
+int lc_event_crossings_find(lc_world *w, lc_event_crossings *ec, const lc_trial *tr, const lc_moved *moved,
+                            const lc_crossing *stalled, int nstalled, lc_crossing **out);
 
 #endif

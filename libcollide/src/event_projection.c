@@ -8,11 +8,29 @@
  * the backstop that keeps drift in a jammed pile from becoming an overlap nothing can see: no step ends
  * overlapping. */
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 #include "world.h"
 #include "event_projection.h"
 #include "event_touches.h"
 #include "tunables.h"
+
+struct lc_event_projection {
+    lc_buf found;           /* the touches a pass found */
+    lc_buf mat, vec, vec2;  /* a pass's response matrix, right-hand side and multipliers */
+};
+
+lc_event_projection *lc_event_projection_create(void) { return calloc(1, sizeof(lc_event_projection)); }
+
+void lc_event_projection_destroy(lc_event_projection *ep)
+{
+    if (ep == NULL) return;
+    lc_buf_free(&ep->found);
+    lc_buf_free(&ep->mat);
+    lc_buf_free(&ep->vec);
+    lc_buf_free(&ep->vec2);
+    free(ep);
+}
 
 /* The projection of a large group (more touches than lcp_exact_max: a pile) by MPRGP on the sparse
  * response (sparse_lcp.c): O(touches) memory and per product where the dense problem would be
@@ -20,10 +38,10 @@
  * seconds per pass). Converged when no gap is off by more than a thousandth of the contact gap. Its
  * budget is 5x the force solve's: it is the last line before a step fails, and a cold 5050-box
  * pyramid (100 layers lifted to the gap at once) needed more than 1000 products per pass. */
-static int project_sparse(lc_world *w, const lc_touch *t, int n)
+static int project_sparse(lc_world *w, lc_event_projection *ep, const lc_touch *t, int n)
 {
-    double *disp = lc_buf_get(&w->b_vec, (size_t)w->count * 3 * sizeof(double));
-    double *lam = lc_buf_get(&w->b_vec2, (size_t)n * 4 * sizeof(double)), *b, *lo, *hi, viol;
+    double *disp = lc_buf_get(&ep->vec, (size_t)w->count * 3 * sizeof(double));
+    double *lam = lc_buf_get(&ep->vec2, (size_t)n * 4 * sizeof(double)), *b, *lo, *hi, viol;
     int i;
     if (!disp || !lam) return -1;
     b = lam + n;
@@ -55,10 +73,10 @@ static int project_sparse(lc_world *w, const lc_touch *t, int n)
 }
 
 /* 1 projected, 0 nothing to do (*found: the touches in b_impact, all at w->state), -1 no memory */
-static int project_once(lc_world *w, double *deepest, int *found)
+static int project_once(lc_world *w, lc_event_projection *ep, lc_event_touches *et, double *deepest, int *found)
 {
-    int n = lc_event_gather_touches(w, w->state, &w->b_impact), i, k = 0;
-    lc_touch *t = (lc_touch *)w->b_impact.p;
+    int n = lc_event_gather_touches(w, et, w->state, &ep->found), i, k = 0;
+    lc_touch *t = (lc_touch *)ep->found.p;
     double *A, *b, *lam;
     lc_lcp_options opt;
     lc_lcp_result res;
@@ -71,11 +89,11 @@ static int project_once(lc_world *w, double *deepest, int *found)
     }
     if (!k) return 0;
     w->last.position_projections++;
-    if (n > w->def.lcp_exact_max) return project_sparse(w, t, n);
+    if (n > w->def.lcp_exact_max) return project_sparse(w, ep, t, n);
     /* every touch takes part, so pushing one pair apart does not push a neighbour in */
-    A = lc_buf_get(&w->b_mat, (size_t)n * (size_t)n * sizeof(double));
-    b = lc_buf_get(&w->b_vec, (size_t)n * sizeof(double));
-    lam = lc_buf_get(&w->b_vec2, (size_t)n * sizeof(double));
+    A = lc_buf_get(&ep->mat, (size_t)n * (size_t)n * sizeof(double));
+    b = lc_buf_get(&ep->vec, (size_t)n * sizeof(double));
+    lam = lc_buf_get(&ep->vec2, (size_t)n * sizeof(double));
     if (!A || !b || !lam) return -1;
     lc_response_matrix(w, t, n, A);
     for (i = 0; i < n; ++i) {
@@ -96,26 +114,17 @@ static int project_once(lc_world *w, double *deepest, int *found)
 }
 
 /* 0 done, 1 still overlapping after every pass (forces far beyond what dt can resolve), -1 no memory. */
-int lc_event_project(lc_world *w)
+int lc_event_project(lc_world *w, lc_event_projection *ep, lc_event_touches *et)
 {
     int pass, r = 0, found = 0;
     double deepest = INFINITY;
     for (pass = 0; pass <= LC_PROJECTION_PASSES; ++pass) {
-        r = project_once(w, &deepest, &found);
+        r = project_once(w, ep, et, &deepest, &found);
         if (r <= 0) break;
     }
     if (r < 0) return -1;
-    if (r == 0) {
-        /* the last search was at the state the step ends in: keep it for the next step's first gather */
-        double *kept = lc_buf_get(&w->b_end_state, (size_t)w->count * 6 * sizeof(double));
-        lc_buf swap = w->b_impact;
-        if (kept == NULL) return -1;
-        memcpy(kept, w->state, (size_t)w->count * 6 * sizeof(double));
-        w->b_impact = w->b_end_touches;
-        w->b_end_touches = swap;
-        w->end_touch_count = found;
-        w->end_edits = w->edits;
-    }
+    /* the last search was at the state the step ends in: keep it for the next step's first gather */
+    if (r == 0 && lc_event_touches_keep_end(w, et, &ep->found, found) != 0) return -1;
     /* the last pass projected again: its touches were measured before that pass */
     if (r > 0 && deepest < -LC_OVERLAP_TOLERANCE) return 1;
     return 0;

@@ -5,6 +5,7 @@
  * the touches (event_touches.c), the detection (event_crossings.c), the touch islands a time-of-impact
  * search advances (touch_islands.c) and the projection (event_projection.c). */
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 #include "world.h"
 #include "event_regime.h"
@@ -19,8 +20,55 @@
 #define LC_STRINGIFY_(x) #x
 #define LC_STRINGIFY(x) LC_STRINGIFY_(x)
 
-lc_status lc_event_advance(lc_world *w, const lc_step_try *step, double dt, double t0, const int *event_rows, int nrows,
-                           int *marks_known, int *handover, double *t_handover)
+struct lc_event_regime {
+    lc_event_touches *touches;
+    lc_event_crossings *crossings;
+    lc_touch_islands *islands;
+    lc_event_projection *projection;
+    lc_buf state0, state1, scratch;  /* a pass's start and trial end, and integration scratch (count x 6) */
+    lc_buf rows, moved, moved_rows;  /* the advanced rows; the bodies the last impact moved */
+    lc_buf marks, at_best;           /* the energy check's marks; the best time of impact's state */
+};
+
+lc_event_regime *lc_event_regime_create(void)
+{
+    lc_event_regime *er = calloc(1, sizeof *er);
+    if (er == NULL) return NULL;
+    er->touches = lc_event_touches_create();
+    er->crossings = lc_event_crossings_create();
+    er->islands = lc_touch_islands_create();
+    er->projection = lc_event_projection_create();
+    if (!er->touches || !er->crossings || !er->islands || !er->projection) {
+        lc_event_regime_destroy(er);
+        return NULL;
+    }
+    return er;
+}
+
+void lc_event_regime_destroy(lc_event_regime *er)
+{
+    if (er == NULL) return;
+    lc_event_touches_destroy(er->touches);
+    lc_event_crossings_destroy(er->crossings);
+    lc_touch_islands_destroy(er->islands);
+    lc_event_projection_destroy(er->projection);
+    lc_buf_free(&er->state0);
+    lc_buf_free(&er->state1);
+    lc_buf_free(&er->scratch);
+    lc_buf_free(&er->rows);
+    lc_buf_free(&er->moved);
+    lc_buf_free(&er->moved_rows);
+    lc_buf_free(&er->marks);
+    lc_buf_free(&er->at_best);
+    free(er);
+}
+
+void lc_event_regime_rows_shifted(lc_event_regime *er) { lc_event_touches_rows_shifted(er->touches); }
+
+void lc_event_regime_forget_end(lc_event_regime *er) { lc_event_touches_forget_end(er->touches); }
+
+lc_status lc_event_advance(lc_world *w, lc_event_regime *er, const lc_step_try *step, double dt, double t0,
+                           const int *event_rows, int nrows, int *marks_known, int *handover, double *t_handover)
 {
     size_t bytes;
     double *s0, *s1, *scratch, remaining;
@@ -30,15 +78,18 @@ lc_status lc_event_advance(lc_world *w, const lc_step_try *step, double dt, doub
     uint8_t *dirty;
     double last_tmin = 0.0, trial_left = 0.0, ts;
     lc_crossing stalled[LC_MAX_STALLED];
+    lc_touch *rest = NULL;
+    const lc_touch *end_touches;
+    int nend;
     bytes = (size_t)(w->count > 0 ? w->count : 1) * 6 * sizeof(double);
-    s0 = lc_buf_get(&w->b_state0, bytes);
-    s1 = lc_buf_get(&w->b_state1, bytes);
-    scratch = lc_buf_get(&w->b_step_scratch, bytes);
-    rows = lc_buf_get(&w->b_rows, (size_t)(w->count > 0 ? w->count : 1) * sizeof(int));
+    s0 = lc_buf_get(&er->state0, bytes);
+    s1 = lc_buf_get(&er->state1, bytes);
+    scratch = lc_buf_get(&er->scratch, bytes);
+    rows = lc_buf_get(&er->rows, (size_t)(w->count > 0 ? w->count : 1) * sizeof(int));
     if (!s0 || !s1 || !scratch || !rows) return lc_fail(w, LC_ERR_NO_MEMORY, "out of memory in step");
     memcpy(rows, event_rows, (size_t)nrows * sizeof(int));
-    dirty = lc_buf_get(&w->b_dirty, (size_t)w->count);
-    drows = lc_buf_get(&w->b_drows, (size_t)w->count * sizeof(int));
+    dirty = lc_buf_get(&er->moved, (size_t)w->count);
+    drows = lc_buf_get(&er->moved_rows, (size_t)w->count * sizeof(int));
     if (!dirty || !drows) return lc_fail(w, LC_ERR_NO_MEMORY, "out of memory in step");
     memset(dirty, 0, (size_t)w->count);
     for (i = 0; i < w->spring_count; ++i)
@@ -47,10 +98,9 @@ lc_status lc_event_advance(lc_world *w, const lc_step_try *step, double dt, doub
     remaining = dt;
     while (remaining > 0.0) {
         int nc, best = -1, nimp, hits, by_pair = 0;
-        lc_touch_islands ti;
         double tmin = remaining;
         lc_crossing *cross;
-        lc_touch *rest;
+        lc_touch *impact;
 
         double trial = remaining, wmax = 0.0;
         int events_before = events, local = 0, can_reuse;
@@ -58,15 +108,16 @@ lc_status lc_event_advance(lc_world *w, const lc_step_try *step, double dt, doub
          * every other pair was apart (nothing rested) and moved without an impact */
         ts = lc_stage_begin(w);
         if (local_next && !body_springs)
-            nrest = lc_event_resting(w, w->state, &events, dirty, drows, ndirty, passes > 0, &started_deep, &persisting);
+            nrest = lc_event_resting(w, er->touches, w->state, &events, dirty, drows, ndirty, passes > 0, &started_deep,
+                                     &persisting, &rest);
         else
-            nrest = lc_event_resting(w, w->state, &events, NULL, NULL, 0, passes > 0, &started_deep, &persisting);
+            nrest = lc_event_resting(w, er->touches, w->state, &events, NULL, NULL, 0, passes > 0, &started_deep,
+                                     &persisting, &rest);
         lc_stage_end(w, &w->last.time_detection, ts);
         if (nrest == -2)
             return lc_step_undo(w, step, LC_ERR_NUMERIC,
                                 "a body passed deep into another within the step (speeds or spins beyond what dt can resolve)");
         if (nrest < 0) goto oom;
-        rest = (lc_touch *)w->b_touch.p;
         /* from here on that touch persists, which the contact regime advances (regime.h); so does a burst
          * of impacts (inelastic collapse: a block bouncing ever lower, e^k, where no speed threshold
          * stops it) */
@@ -125,14 +176,14 @@ lc_status lc_event_advance(lc_world *w, const lc_step_try *step, double dt, doub
                                         "integration produced a non-finite state (forces too stiff for dt?)");
         }
         if (nrest > 0) {
-            uint8_t *mark = lc_buf_get(&w->b_emark, (size_t)w->count);
+            uint8_t *mark = lc_buf_get(&er->marks, (size_t)w->count);
             if (mark == NULL) goto oom;
             memset(mark, 0, (size_t)w->count);
             if (lc_contact_energy_blew_up(w, s0, s1, rest, nrest, mark))
                 return lc_step_undo(w, step, LC_ERR_NUMERIC,
                                     "contact forces gained energy (speeds or spins beyond what dt can resolve)");
         }
-        if (lc_event_keep_warm(w, rest, nrest) != 0) goto oom;
+        if (lc_event_keep_warm(er->touches, rest, nrest) != 0) goto oom;
         tmin = trial;
 
         /* vertices that entered another body during the trial step */
@@ -151,7 +202,7 @@ lc_status lc_event_advance(lc_world *w, const lc_step_try *step, double dt, doub
             moved.n = ndirty;
             moved.since = last_tmin;
             ts = lc_stage_begin(w);
-            nc = lc_event_crossings_find(w, &tr, local ? &moved : NULL, stalled, nstalled, &cross);
+            nc = lc_event_crossings_find(w, er->crossings, &tr, local ? &moved : NULL, stalled, nstalled, &cross);
             lc_stage_end(w, &w->last.time_detection, ts);
             if (nc < 0) goto oom;
         }
@@ -160,7 +211,7 @@ lc_status lc_event_advance(lc_world *w, const lc_step_try *step, double dt, doub
          * the best time so far are kept for the next crossing of the same islands (a pile is one
          * island, and each of its integrations solves the whole pile's contact forces). */
         ts = lc_stage_begin(w);
-        if (nc > 0 && lc_touch_islands_build(w, rows, nrows, rest, nrest, &ti) != 0) goto oom;
+        if (nc > 0 && lc_touch_islands_build(w, er->islands, rows, nrows, rest, nrest) != 0) goto oom;
         {
             double *at_best = NULL, at_t = -1.0;
             int at_ia = -2, at_ib = -2;
@@ -169,11 +220,11 @@ lc_status lc_event_advance(lc_world *w, const lc_step_try *step, double dt, doub
                 const int *erows;
                 int nerows, nerest;
                 lc_touch *erest;
-                if (lc_touch_islands_of(w, &ti, cross[i].a, cross[i].b, &erows, &nerows, &erest, &nerest) != 0) goto oom;
+                if (lc_touch_islands_of(er->islands, cross[i].a, cross[i].b, &erows, &nerows, &erest, &nerest) != 0) goto oom;
                 if (best >= 0) {
                     double g;
-                    int ia = ti.of[cross[i].a], ib = ti.of[cross[i].b];
-                    if (at_best == NULL && (at_best = lc_buf_get(&w->b_sample0, bytes)) == NULL) goto oom;
+                    int ia = lc_touch_island(er->islands, cross[i].a), ib = lc_touch_island(er->islands, cross[i].b);
+                    if (at_best == NULL && (at_best = lc_buf_get(&er->at_best, bytes)) == NULL) goto oom;
                     if (at_t != tmin || at_ia != ia || at_ib != ib) {
                         if (lc_integrate(w, s0, tmin, erows, nerows, erest, nerest, at_best) != 0) goto oom;
                         at_t = tmin;
@@ -211,7 +262,7 @@ lc_status lc_event_advance(lc_world *w, const lc_step_try *step, double dt, doub
                 int nerows, nerest;
                 lc_touch *erest;
                 double t2;
-                if (lc_touch_islands_of(w, &ti, ba, bb, &erows, &nerows, &erest, &nerest) != 0) goto oom;
+                if (lc_touch_islands_of(er->islands, ba, bb, &erows, &nerows, &erest, &nerest) != 0) goto oom;
                 lc_stage_end(w, &w->last.time_integration, ts);
                 ts = lc_stage_begin(w);
                 t2 = lc_pair_time_of_impact(w, s0, tmin, ba, bb, erows, nerows, erest, nerest, scratch);
@@ -231,14 +282,14 @@ lc_status lc_event_advance(lc_world *w, const lc_step_try *step, double dt, doub
         if (remaining < 1e-14 * dt) remaining = 0.0;
 
         ts = lc_stage_begin(w);
-        nimp = lc_event_impact_group(w, w->state, &cross[best], by_pair);
+        nimp = lc_event_impact_group(w, er->touches, w->state, &cross[best], by_pair, &impact);
         if (nimp < 0) goto oom;
         /* past max_events_per_step (an impact storm: extreme speeds in a small box, a jam at e > 0)
          * every further impact is inelastic, which ends the storm; the pass cap above still bounds it */
-        hits = lc_resolve_impacts(w, w->state, (lc_touch *)w->b_impact.p, nimp, events < w->def.max_events_per_step);
+        hits = lc_resolve_impacts(w, w->state, impact, nimp, events < w->def.max_events_per_step);
         if (hits < 0) goto oom;
         {
-            lc_touch *t = (lc_touch *)w->b_impact.p;
+            lc_touch *t = impact;
             int dissipative = 0;
             for (i = 0; i < nimp; ++i)
                 if (t[i].value > 0.0) {
@@ -256,7 +307,7 @@ lc_status lc_event_advance(lc_world *w, const lc_step_try *step, double dt, doub
         events++;
         {
             /* the impact's bodies are the ones whose paths changed (see `local` above) */
-            lc_touch *t = (lc_touch *)w->b_impact.p;
+            lc_touch *t = impact;
             for (i = 0; i < ndirty; ++i) dirty[drows[i]] = 0;
             ndirty = 0;
             for (i = 0; i < nimp; ++i) {
@@ -284,7 +335,7 @@ lc_status lc_event_advance(lc_world *w, const lc_step_try *step, double dt, doub
     {
         int pr;
         ts = lc_stage_begin(w);
-        pr = lc_event_project(w);
+        pr = lc_event_project(w, er->projection, er->touches);
         lc_stage_end(w, &w->last.time_projection, ts);
         if (pr < 0) goto oom;
         if (pr > 0)
@@ -293,19 +344,17 @@ lc_status lc_event_advance(lc_world *w, const lc_step_try *step, double dt, doub
     }
 
     /* resting contacts at the end of the step, with the forces of the last evaluation */
-    {
-        lc_touch *rest = (lc_touch *)w->b_touch.p;
-        for (i = 0; i < nrest; ++i) {
-            lc_touch t = rest[i];
-            lc_touch_update(w, w->state, &t);
-            if (lc_push_contact(w, &t, LC_CONTACT_RESTING) != 0) goto oom;
-        }
+    for (i = 0; i < nrest; ++i) {
+        lc_touch t = rest[i];
+        lc_touch_update(w, w->state, &t);
+        if (lc_push_contact(w, &t, LC_CONTACT_RESTING) != 0) goto oom;
     }
     /* what the event rows rest on at the end, for the next step's regime (the projection's last search
      * was at the end state when it kept its touches) */
     for (i = 0; i < nrows; ++i) w->rests_dissipative[rows[i]] = 0;
-    *marks_known = w->end_touch_count >= 0 || nrows == 0;
-    if (w->end_touch_count >= 0) lc_regime_mark(w, (const lc_touch *)w->b_end_touches.p, w->end_touch_count);
+    nend = lc_event_touches_end(er->touches, &end_touches);
+    *marks_known = nend >= 0 || nrows == 0;
+    if (nend >= 0) lc_regime_mark(w, end_touches, nend);
     return LC_OK;
 oom:
     return lc_step_undo(w, step, LC_ERR_NO_MEMORY, "out of memory during the step");

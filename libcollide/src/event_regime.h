@@ -6,14 +6,24 @@
 
 #include "world.h"
 
+typedef struct lc_event_regime lc_event_regime;   /* owned by the world */
+
+lc_event_regime *lc_event_regime_create(void);
+void lc_event_regime_destroy(lc_event_regime *er);
+/* Rows shifted (a body was removed): what the regime kept by rows from the last pass is dropped. */
+void lc_event_regime_rows_shifted(lc_event_regime *er);
+/* The touches kept at the end of the last event pass no longer describe the state (the contact regime
+ * moved bodies since). */
+void lc_event_regime_forget_end(lc_event_regime *er);
+
 /* Advances the dynamic rows[0..nrows) from time t0 by dt (the rest of the step `step` tries), every other
  * dynamic body left out of its pairs (w->excluded). With `handover` non-NULL it stops at the first
  * instant a touch between bodies that are not perfectly elastic rests (or after LC_HANDOVER_EVENTS
  * dissipative impacts), with every row advanced to that instant: *handover is then that touch's island
  * (islands.h) and *t_handover the time it took; otherwise *handover is -1 and the rows reach the end of
  * the step, projected. *marks_known: w->rests_dissipative describes the rows' end state. LC_OK, or the
- * step has failed (and is undone, lc_step_undo). */
-lc_status lc_event_advance(lc_world *w, const lc_step_try *step, double dt, double t0, const int *rows, int nrows,
-                           int *marks_known, int *handover, double *t_handover);
+ * error (the step undone by lc_step_undo, unless memory ran out before the first pass). */
+lc_status lc_event_advance(lc_world *w, lc_event_regime *er, const lc_step_try *step, double dt, double t0,
+                           const int *rows, int nrows, int *marks_known, int *handover, double *t_handover);
 
 #endif

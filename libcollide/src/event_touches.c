@@ -2,42 +2,101 @@
  * the group of touches an impact acts on, and the whole-world searches, which take the touches the
  * last step's projection found when nothing has moved since. */
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 #include "world.h"
 #include "event_touches.h"
+
+struct lc_event_touches {
+    lc_buf pairs;          /* the broad phase's pairs of a search */
+    lc_buf rest;           /* the resting set of the pass in progress */
+    lc_buf impact;         /* the touches of an impact */
+    lc_buf group;          /* an impact group's queue and marks */
+    lc_buf warm, hash;     /* the last pass's resting touches and forces (warm_count), and their hash table */
+    int warm_count;
+    /* the touches the last step's projection found at the state it ended in (end_count, -1: none), that
+     * state and the world's `edits` then */
+    lc_buf end_touches, end_state;
+    int end_count;
+    unsigned long end_edits;
+};
+
+lc_event_touches *lc_event_touches_create(void)
+{
+    lc_event_touches *et = calloc(1, sizeof *et);
+    if (et != NULL) et->end_count = -1;
+    return et;
+}
+
+void lc_event_touches_destroy(lc_event_touches *et)
+{
+    if (et == NULL) return;
+    lc_buf_free(&et->pairs);
+    lc_buf_free(&et->rest);
+    lc_buf_free(&et->impact);
+    lc_buf_free(&et->group);
+    lc_buf_free(&et->warm);
+    lc_buf_free(&et->hash);
+    lc_buf_free(&et->end_touches);
+    lc_buf_free(&et->end_state);
+    free(et);
+}
+
+void lc_event_touches_rows_shifted(lc_event_touches *et) { et->warm_count = 0; }
+
+void lc_event_touches_forget_end(lc_event_touches *et) { et->end_count = -1; }
+
+int lc_event_touches_end(const lc_event_touches *et, const lc_touch **t)
+{
+    *t = (const lc_touch *)et->end_touches.p;
+    return et->end_count;
+}
+
+int lc_event_touches_keep_end(lc_world *w, lc_event_touches *et, lc_buf *found, int n)
+{
+    double *kept = lc_buf_get(&et->end_state, (size_t)w->count * 6 * sizeof(double));
+    lc_buf swap = *found;
+    if (kept == NULL) return -1;
+    memcpy(kept, w->state, (size_t)w->count * 6 * sizeof(double));
+    *found = et->end_touches;
+    et->end_touches = swap;
+    et->end_count = n;
+    et->end_edits = w->edits;
+    return 0;
+}
 
 /* The touches the last step's projection found at the state it ended in, moved into buf, if this
  * gather is at that same state (-1: none kept, or something changed since). The first gather of a
  * step is at the state the previous one ended in, so in a world at rest or in free flight one of the
  * two whole-world touch searches per step is saved (the projection has to look at the end state,
  * the next step's resting set at its start). One use: every later gather of the step is elsewhere. */
-static int kept_end_touches(lc_world *w, const double *state, lc_buf *buf)
+static int kept_end_touches(lc_world *w, lc_event_touches *et, const double *state, lc_buf *buf)
 {
-    int n = w->end_touch_count;
+    int n = et->end_count;
     lc_buf swap;
-    w->end_touch_count = -1;
-    if (n < 0 || w->end_edits != w->edits || state != w->state ||
-        memcmp(w->b_end_state.p, state, (size_t)w->count * 6 * sizeof(double)) != 0)
+    et->end_count = -1;
+    if (n < 0 || et->end_edits != w->edits || state != w->state ||
+        memcmp(et->end_state.p, state, (size_t)w->count * 6 * sizeof(double)) != 0)
         return -1;
     swap = *buf;
-    *buf = w->b_end_touches;
-    w->b_end_touches = swap;
+    *buf = et->end_touches;
+    et->end_touches = swap;
     return n;
 }
 
 /* Touches at `state` with gap < contact_distance, appended to buf from 0: between all near pairs, or
  * (list != NULL) only the pairs with at least one of the listed bodies (marked[row] != 0). */
-static int gather_touches_of(lc_world *w, const double *state, const uint8_t *marked, const int *list, int nlist,
-                             lc_buf *buf)
+static int gather_touches_of(lc_world *w, lc_event_touches *et, const double *state, const uint8_t *marked,
+                             const int *list, int nlist, lc_buf *buf)
 {
     int np, i, n = 0;
     const int *pairs;
-    if (list == NULL && (n = kept_end_touches(w, state, buf)) >= 0) return n;
+    if (list == NULL && (n = kept_end_touches(w, et, state, buf)) >= 0) return n;
     n = 0;
-    np = list ? lc_broad_phase_of(w, state, state, w->def.contact_distance, marked, list, nlist, &w->b_pairs)
-              : lc_broad_phase(w, state, state, w->def.contact_distance, &w->b_pairs);
+    np = list ? lc_broad_phase_of(w, state, state, w->def.contact_distance, marked, list, nlist, &et->pairs)
+              : lc_broad_phase(w, state, state, w->def.contact_distance, &et->pairs);
     if (np < 0) return -1;
-    pairs = (const int *)w->b_pairs.p;
+    pairs = (const int *)et->pairs.p;
     for (i = 0; i < np; ++i) {
         n = lc_collect_touches(w, state, pairs[2 * i], pairs[2 * i + 1], w->def.contact_distance, buf, n);
         if (n < 0) return -1;
@@ -46,9 +105,9 @@ static int gather_touches_of(lc_world *w, const double *state, const uint8_t *ma
 }
 
 /* Touches between all near pairs at `state` with gap < contact_distance, appended to buf from 0. */
-int lc_event_gather_touches(lc_world *w, const double *state, lc_buf *buf)
+int lc_event_gather_touches(lc_world *w, lc_event_touches *et, const double *state, lc_buf *buf)
 {
-    return gather_touches_of(w, state, NULL, NULL, 0, buf);
+    return gather_touches_of(w, et, state, NULL, NULL, 0, buf);
 }
 
 /* Key of a touch (bodies, vertex and edge) for the warm start's hash table. */
@@ -64,14 +123,14 @@ static uint32_t touch_key(const lc_world *w, const lc_touch *t)
 
 /* Start each resting touch from the force it carried in the previous pass (same bodies, vertex and
  * edge): resting forces change little between steps, so the iterative solver starts near the answer. */
-static int warm_start(lc_world *w, lc_touch *t, int n)
+static int warm_start(const lc_world *w, lc_event_touches *et, lc_touch *t, int n)
 {
-    const lc_touch *old = (const lc_touch *)w->b_warm.p;
-    int m = w->warm_count, size = 1, i;
+    const lc_touch *old = (const lc_touch *)et->warm.p;
+    int m = et->warm_count, size = 1, i;
     int *table;
     if (m == 0 || n == 0) return 0;
     while (size < 2 * m) size *= 2;
-    table = lc_buf_get(&w->b_hash, (size_t)size * sizeof(int));
+    table = lc_buf_get(&et->hash, (size_t)size * sizeof(int));
     if (table == NULL) return -1;
     for (i = 0; i < size; ++i) table[i] = -1;
     for (i = 0; i < m; ++i) {
@@ -102,13 +161,13 @@ static int warm_start(lc_world *w, lc_touch *t, int n)
  * crossing test can see any more (they start inside); they are resolved here, before the step.
  * Returns the resting count, -1 (no memory) or -2 (a point has passed deep into another body: the
  * step must fail). */
-int lc_event_resting(lc_world *w, double *state, int *impacts, const uint8_t *marked, const int *list, int nlist,
-                     int mid_step, int *started_deep, int *persisting)
+int lc_event_resting(lc_world *w, lc_event_touches *et, double *state, int *impacts, const uint8_t *marked,
+                     const int *list, int nlist, int mid_step, int *started_deep, int *persisting, lc_touch **rest)
 {
     int n, i, k = 0, urgent = 0;
     lc_touch *t;
-    n = gather_touches_of(w, state, marked, list, nlist, &w->b_touch);
-    t = (lc_touch *)w->b_touch.p;
+    n = gather_touches_of(w, et, state, marked, list, nlist, &et->rest);
+    t = *rest = (lc_touch *)et->rest.p;
     if (n < 0) return -1;
     /* Within a step (mid_step: not its first pass) that started without one, a point a quarter of
      * the smaller body's size (and at least 100 contact_distances: a 1e-12 m polygon is not "deep" at
@@ -130,7 +189,7 @@ int lc_event_resting(lc_world *w, double *state, int *impacts, const uint8_t *ma
         if (t[i].gap <= w->def.contact_gap + w->def.toi_distance_tolerance && t[i].vn < -w->def.resting_speed)
             urgent = 1;
     if (urgent) {
-        lc_touch *x = lc_buf_get(&w->b_impact, (size_t)n * sizeof(lc_touch));
+        lc_touch *x = lc_buf_get(&et->impact, (size_t)n * sizeof(lc_touch));
         if (x == NULL) return -1;
         memcpy(x, t, (size_t)n * sizeof(lc_touch));
         if (lc_resolve_impacts(w, state, x, n, *impacts < w->def.max_events_per_step) < 0) return -1;
@@ -174,17 +233,17 @@ int lc_event_resting(lc_world *w, double *state, int *impacts, const uint8_t *ma
              t[i].vn <= (t[i].elasticity >= 1.0 ? 1e-2 : 1.0) * w->def.resting_speed) ||
             (t[i].gap < -0.5 * w->def.contact_gap && t[i].vn > 0.0))
             t[k++] = t[i];
-    if (warm_start(w, t, k) != 0) return -1;
+    if (warm_start(w, et, t, k) != 0) return -1;
     return k;
 }
 
 /* Keeps this pass's resting touches and their forces for the next pass's warm start. */
-int lc_event_keep_warm(lc_world *w, const lc_touch *t, int n)
+int lc_event_keep_warm(lc_event_touches *et, const lc_touch *t, int n)
 {
-    lc_touch *dst = lc_buf_get(&w->b_warm, (size_t)(n > 0 ? n : 1) * sizeof(lc_touch));
+    lc_touch *dst = lc_buf_get(&et->warm, (size_t)(n > 0 ? n : 1) * sizeof(lc_touch));
     if (dst == NULL) return -1;
     if (n > 0) memcpy(dst, t, (size_t)n * sizeof(lc_touch));
-    w->warm_count = n;
+    et->warm_count = n;
     return 0;
 }
 
@@ -193,9 +252,10 @@ int lc_event_keep_warm(lc_world *w, const lc_touch *t, int n)
  * spreading out from those two bodies, so its cost follows the group's size rather than the world's.
  * When the time came from the pair's separation (by_pair), the crossing's vertex need not be the one
  * touching: the pair's touches are its separating-axis manifold alone. */
-int lc_event_impact_group(lc_world *w, const double *state, const lc_crossing *c, int by_pair)
+int lc_event_impact_group(lc_world *w, lc_event_touches *et, const double *state, const lc_crossing *c, int by_pair,
+                          lc_touch **out)
 {
-    int *queue = lc_buf_get(&w->b_group, (size_t)w->count * (sizeof(int) + 1));
+    int *queue = lc_buf_get(&et->group, (size_t)w->count * (sizeof(int) + 1));
     uint8_t *seen;   /* 1 queued, 2 done */
     int n = 0, i, k, q, nq = 0, have = 0;
     lc_touch *t;
@@ -216,13 +276,13 @@ int lc_event_impact_group(lc_world *w, const double *state, const lc_crossing *c
             r = w->shape[body].radius + w->shape[k].radius + w->def.contact_distance;
             if (dx * dx + dy * dy > r * r) continue;
             n = lc_collect_touches(w, state, body < k ? body : k, body < k ? k : body, w->def.contact_distance,
-                                   &w->b_impact, n);
+                                   &et->impact, n);
             if (n < 0) return -1;
             if (n > before && !w->is_static[k] && !seen[k]) { seen[k] = 1; queue[nq++] = k; }
         }
         seen[body] = 2;
     }
-    t = (lc_touch *)w->b_impact.p;
+    t = (lc_touch *)et->impact.p;
     for (i = 0; i < n && !by_pair; ++i)
         if (t[i].a == c->a && t[i].vertex == c->vertex && t[i].b == c->b) {
             /* at a corner two edges are equally near; the vertex came in through the crossing's edge */
@@ -235,7 +295,7 @@ int lc_event_impact_group(lc_world *w, const double *state, const lc_crossing *c
     if (!have && !by_pair) {
         /* the crossing vertex was not found as a touch (e.g. it meets the other body's corner):
          * use the crossing itself so the impact is never lost */
-        lc_touch *x = lc_buf_get(&w->b_impact, (size_t)(n + 1) * sizeof(lc_touch));
+        lc_touch *x = lc_buf_get(&et->impact, (size_t)(n + 1) * sizeof(lc_touch));
         if (x == NULL) return -1;
         memset(&x[n], 0, sizeof x[n]);
         x[n].a = c->a;
@@ -247,5 +307,6 @@ int lc_event_impact_group(lc_world *w, const double *state, const lc_crossing *c
         lc_touch_update(w, state, &x[n]);
         n++;
     }
+    *out = (lc_touch *)et->impact.p;
     return n;
 }

@@ -117,7 +117,7 @@ static lc_status advance_islands(lc_world *w, const lc_step_try *step, double dt
             /* the event regime's pairs leave out the contact islands' bodies, and its kept end touches
              * would not describe them */
             w->excluded = excluded;
-            w->end_touch_count = -1;
+            lc_event_regime_forget_end(w->event);
         }
         if (n_event == 0 && any_contact) {
             /* every island was the contact regime's: no event pass (its broadphases would find nothing) */
@@ -130,7 +130,7 @@ static lc_status advance_islands(lc_world *w, const lc_step_try *step, double dt
                                     "(speeds or spins beyond what dt can resolve)");
             return LC_OK;
         }
-        st = lc_event_advance(w, step, step->time0 + dt - t0, t0, event_rows, n_event, marks_known,
+        st = lc_event_advance(w, w->event, step, step->time0 + dt - t0, t0, event_rows, n_event, marks_known,
                               w->def.regime == LC_REGIME_AUTO ? &handover : NULL, &t_handover);
         w->excluded = NULL;
         if (st != LC_OK || handover < 0) break;
@@ -144,7 +144,7 @@ static lc_status advance_islands(lc_world *w, const lc_step_try *step, double dt
             any_contact = 1;
         }
     }
-    if (any_contact) w->end_touch_count = -1;
+    if (any_contact) lc_event_regime_forget_end(w->event);
     return st;
 }
 

@@ -4,9 +4,34 @@
  * of the crossing's two bodies; integrating the whole world there made every evaluation in a settling
  * scene (20 blocks, each on the floor) solve all of their contact forces, ~2000 force evaluations per
  * step. Rows and touches are sorted by island, in their order. */
+#include <stdlib.h>
 #include <string.h>
 #include "world.h"
 #include "touch_islands.h"
+
+struct lc_touch_islands {
+    int *of;                  /* island of each body row, -1 for static bodies */
+    int *rows, *row_start;    /* rows of island k: rows[row_start[k] .. row_start[k + 1]) */
+    lc_touch *touches;        /* resting touches of island k: likewise, with touch_start */
+    int *touch_start;
+    int count;
+    lc_buf ints, sorted;      /* of, the union-find's parents, rows, row_start, touch_start, cursors; touches */
+    lc_buf pick, pick_touches; /* the rows and touches of two islands side by side */
+};
+
+lc_touch_islands *lc_touch_islands_create(void) { return calloc(1, sizeof(lc_touch_islands)); }
+
+void lc_touch_islands_destroy(lc_touch_islands *is)
+{
+    if (is == NULL) return;
+    lc_buf_free(&is->ints);
+    lc_buf_free(&is->sorted);
+    lc_buf_free(&is->pick);
+    lc_buf_free(&is->pick_touches);
+    free(is);
+}
+
+int lc_touch_island(const lc_touch_islands *is, int row) { return is->of[row]; }
 
 static int island_root(int *parent, int x)
 {
@@ -23,12 +48,12 @@ static void island_join(int *parent, int a, int b)
     if (ra != rb) parent[ra < rb ? rb : ra] = ra < rb ? ra : rb;
 }
 
-int lc_touch_islands_build(lc_world *w, const int *rows, int nrows, const lc_touch *rest, int nrest,
-                           lc_touch_islands *is)
+int lc_touch_islands_build(const lc_world *w, lc_touch_islands *is, const int *rows, int nrows, const lc_touch *rest,
+                           int nrest)
 {
-    int *v = lc_buf_get(&w->b_isl, ((size_t)w->count * 2 + (size_t)nrows * 4 + 3) * sizeof(int));
+    int *v = lc_buf_get(&is->ints, ((size_t)w->count * 2 + (size_t)nrows * 4 + 3) * sizeof(int));
     int *parent, *cursor, i, k;
-    is->touches = lc_buf_get(&w->b_isl_touch, (size_t)(nrest > 0 ? nrest : 1) * sizeof(lc_touch));
+    is->touches = lc_buf_get(&is->sorted, (size_t)(nrest > 0 ? nrest : 1) * sizeof(lc_touch));
     if (v == NULL || is->touches == NULL) return -1;
     is->of = v;
     parent = v + w->count;
@@ -69,8 +94,8 @@ int lc_touch_islands_build(lc_world *w, const int *rows, int nrows, const lc_tou
 }
 
 /* The rows and resting touches of the islands of bodies a and b (one island, or both side by side). */
-int lc_touch_islands_of(lc_world *w, const lc_touch_islands *is, int a, int b, const int **rows, int *nrows,
-                        lc_touch **touches, int *ntouches)
+int lc_touch_islands_of(lc_touch_islands *is, int a, int b, const int **rows, int *nrows, lc_touch **touches,
+                        int *ntouches)
 {
     int ia = is->of[a], ib = is->of[b], nr, nt;
     int *r;
@@ -92,8 +117,8 @@ int lc_touch_islands_of(lc_world *w, const lc_touch_islands *is, int a, int b, c
     }
     nr = is->row_start[ia + 1] - is->row_start[ia];
     nt = is->touch_start[ia + 1] - is->touch_start[ia];
-    r = lc_buf_get(&w->b_isl_pick, (size_t)(nr + is->row_start[ib + 1] - is->row_start[ib]) * sizeof(int));
-    t = lc_buf_get(&w->b_isl_pick_touch,
+    r = lc_buf_get(&is->pick, (size_t)(nr + is->row_start[ib + 1] - is->row_start[ib]) * sizeof(int));
+    t = lc_buf_get(&is->pick_touches,
                    (size_t)(nt + is->touch_start[ib + 1] - is->touch_start[ib] + 1) * sizeof(lc_touch));
     if (r == NULL || t == NULL) return -1;
     memcpy(r, is->rows + is->row_start[ia], (size_t)nr * sizeof(int));

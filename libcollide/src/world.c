@@ -7,6 +7,7 @@
 #include "world.h"
 #include "islands.h"
 #include "contact_regime.h"
+#include "event_regime.h"
 
 /* ---- scratch and errors ------------------------------------------------------------------ */
 
@@ -197,7 +198,9 @@ lc_world *lc_world_create(const lc_world_def *def, char *errbuf, size_t errbuf_l
         w->lcp = lc_lcp_workspace_create();
         w->islands = lc_islands_create();
         w->contact = lc_contact_regime_create();
-        if (w->lcp == NULL || w->islands == NULL || w->contact == NULL) s = lc_fail(w, LC_ERR_NO_MEMORY, "out of memory");
+        w->event = lc_event_regime_create();
+        if (w->lcp == NULL || w->islands == NULL || w->contact == NULL || w->event == NULL)
+            s = lc_fail(w, LC_ERR_NO_MEMORY, "out of memory");
     }
     if (s != LC_OK) {
         if (errbuf && errbuf_len) snprintf(errbuf, errbuf_len, "%s", w->error);
@@ -206,7 +209,6 @@ lc_world *lc_world_create(const lc_world_def *def, char *errbuf, size_t errbuf_l
     }
     w->def = *def;
     w->next_body_id = 1;
-    w->end_touch_count = -1;
     w->next_spring_id = 1;
     if (errbuf && errbuf_len) errbuf[0] = '\0';
     return w;
@@ -226,13 +228,14 @@ void lc_world_destroy(lc_world *w)
     lc_buf_free(&w->b_marks0); lc_buf_free(&w->b_reach); lc_buf_free(&w->b_reach_boxes);
     lc_buf_free(&w->b_force_event);
     lc_contact_regime_destroy(w->contact);
-    lc_buf_free(&w->b_state0); lc_buf_free(&w->b_state1); lc_buf_free(&w->b_backup);
+    lc_event_regime_destroy(w->event);
+    lc_buf_free(&w->b_backup);
     for (i = 0; i < 4; ++i) lc_buf_free(&w->b_k[i]);
     lc_buf_free(&w->b_tmp); lc_buf_free(&w->b_acc); lc_buf_free(&w->b_touch); lc_buf_free(&w->b_rest);
-    lc_buf_free(&w->b_pairs); lc_buf_free(&w->b_aabb); lc_buf_free(&w->b_rows); lc_buf_free(&w->b_island);
+    lc_buf_free(&w->b_pairs); lc_buf_free(&w->b_aabb); lc_buf_free(&w->b_island);
     lc_buf_free(&w->b_flags); lc_buf_free(&w->b_mat); lc_buf_free(&w->b_vec); lc_buf_free(&w->b_vec2);
-    lc_buf_free(&w->b_step_scratch); lc_buf_free(&w->b_sample0); lc_buf_free(&w->b_sample1); lc_buf_free(&w->b_swept); lc_buf_free(&w->b_end_touches); lc_buf_free(&w->b_end_state); lc_buf_free(&w->b_marked_rows); lc_buf_free(&w->b_have_box); lc_buf_free(&w->b_bound_boxes); lc_buf_free(&w->b_sweep_order); lc_buf_free(&w->b_sweep_boxes); lc_buf_free(&w->b_pair_start); lc_buf_free(&w->b_pair_tmp); lc_buf_free(&w->b_rkeys); lc_buf_free(&w->b_emark); lc_buf_free(&w->b_isl); lc_buf_free(&w->b_isl_touch); lc_buf_free(&w->b_isl_pick); lc_buf_free(&w->b_isl_pick_touch); lc_buf_free(&w->b_sparse); lc_buf_free(&w->b_sparse_body); lc_buf_free(&w->b_sparse_rows); lc_buf_free(&w->b_group_rows); lc_buf_free(&w->b_load); lc_buf_free(&w->b_load_graph); lc_buf_free(&w->b_dirty); lc_buf_free(&w->b_drows); lc_buf_free(&w->b_group); lc_buf_free(&w->b_fric); lc_buf_free(&w->b_cfric); lc_buf_free(&w->b_order); lc_buf_free(&w->b_cross);
-    lc_buf_free(&w->b_impact); lc_buf_free(&w->b_irows); lc_buf_free(&w->b_coupled); lc_buf_free(&w->b_dacc); lc_buf_free(&w->b_diag); lc_buf_free(&w->b_warm); lc_buf_free(&w->b_hash);
+    lc_buf_free(&w->b_marked_rows); lc_buf_free(&w->b_have_box); lc_buf_free(&w->b_bound_boxes); lc_buf_free(&w->b_sweep_order); lc_buf_free(&w->b_sweep_boxes); lc_buf_free(&w->b_pair_start); lc_buf_free(&w->b_pair_tmp); lc_buf_free(&w->b_sparse); lc_buf_free(&w->b_sparse_body); lc_buf_free(&w->b_sparse_rows); lc_buf_free(&w->b_group_rows); lc_buf_free(&w->b_load); lc_buf_free(&w->b_load_graph); lc_buf_free(&w->b_fric); lc_buf_free(&w->b_cfric); lc_buf_free(&w->b_order);
+    lc_buf_free(&w->b_irows); lc_buf_free(&w->b_dacc); lc_buf_free(&w->b_diag);
     free(w);
 }
 
@@ -492,7 +495,7 @@ lc_status lc_world_remove_body(lc_world *w, lc_body_id id)
     for (i = row; i < w->count; ++i) w->id_to_row[w->ids[i]] = i;
     remove_springs_of(w, id);
     w->contact_count = 0;
-    w->warm_count = 0;   /* kept touches refer to rows, which just shifted */
+    lc_event_regime_rows_shifted(w->event);   /* kept touches refer to rows, which just shifted */
     return ok(w);
 }
 

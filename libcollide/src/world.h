@@ -98,6 +98,7 @@ struct lc_world {
 
     struct lc_islands *islands;          /* islands.c */
     struct lc_contact_regime *contact;   /* contact_regime.c */
+    struct lc_event_regime *event;       /* event_regime.c */
     unsigned long regime_edits;          /* regime.c: `edits` when rests_dissipative last described the state */
     const uint8_t *excluded;             /* step.c: dynamic rows left out of every pair (other islands) */
     lc_buf b_event_rows, b_excluded;     /* step.c */
@@ -107,39 +108,23 @@ struct lc_world {
 
     /* scratch, reused between steps */
     lc_lcp_workspace *lcp;
-    lc_buf b_state0, b_state1, b_backup, b_k[4], b_tmp, b_acc;
-    lc_buf b_touch, b_rest, b_pairs, b_aabb, b_rows, b_island, b_flags, b_mat, b_vec, b_vec2, b_order;
-    lc_buf b_step_scratch;   /* step.c only: held across the whole step, so no other file may use it */
-    lc_buf b_sample0, b_sample1; /* step.c only: sub-interval states of the swept check */
+    lc_buf b_backup, b_k[4], b_tmp, b_acc;
+    lc_buf b_touch, b_rest, b_pairs, b_aabb, b_island, b_flags, b_mat, b_vec, b_vec2, b_order;
     lc_buf b_marked_rows;    /* broad_phase.c: the marked rows of lc_broad_phase_of in row order */
     lc_buf b_have_box, b_bound_boxes; /* broad_phase.c: lc_broad_phase_of's computed boxes, bounds */
     /* broad_phase.c: the rows in the last sort-and-sweep's x order (sweep_rows of them), the boxes
      * being sorted, and the counting sort of the pairs */
     lc_buf b_sweep_order, b_sweep_boxes, b_pair_start, b_pair_tmp;
     int sweep_rows;
-    lc_buf b_swept;          /* step.c only: the whole world at the swept check's sub-times */
-    lc_buf b_rkeys;
-    lc_buf b_emark;          /* step.c only: bodies under resting contact, for the energy check */
-    lc_buf b_isl, b_isl_touch, b_isl_pick, b_isl_pick_touch; /* step.c only: islands of a pass */
     lc_buf b_sparse, b_sparse_body, b_sparse_rows; /* sparse_lcp.c: its vectors, the bodies' responses, its rows */
     double sparse_norm[2];   /* sparse_lcp.c: last ||A|| estimate of normal [0] and tangent [1] rows, */
     int sparse_norm_rows[2]; /* and its row count: a pile's A changes little from one solve to the next */
     lc_buf b_group_rows;     /* contact_forces.c: right-hand sides, bounds and forces of a large group */
     lc_buf b_load, b_load_graph; /* static_load.c: per-body loads, and the graph of who rests on whom */
-    lc_buf b_dirty, b_drows; /* step.c only: bodies whose motion the last impact changed */
-    lc_buf b_group;          /* step.c only: bodies of an impact group, in the order found */
-    int cross_count;         /* step.c only: crossings in b_cross at the end of the last pass */
-    /* step.c only: the touches the end-of-step projection found at the state the step ended in, for
-     * the next step's first gather when neither the state nor `edits` changed in between */
-    lc_buf b_end_touches, b_end_state;
-    int end_touch_count;     /* -1: none kept */
-    unsigned long end_edits;
     unsigned long edits;     /* bumped by every API call that changes bodies, their states or materials */
     lc_buf b_fric;           /* impulse.c: friction rows of an impact */
     lc_buf b_cfric;          /* contact_forces.c: normal and tangent blocks of a friction group */
-    /* b_hash, step.c only: hash of the resting vertices of a pass */
-    lc_buf b_cross, b_impact, b_irows, b_coupled, b_dacc, b_diag, b_warm, b_hash;
-    int warm_count;          /* resting touches kept in b_warm from the previous pass (warm start) */
+    lc_buf b_irows, b_dacc, b_diag;
     double step_dt;          /* dt of the step in progress (stabilisation time scale) */
 };
 
