@@ -3,6 +3,7 @@
  * regimes live in their own files: the event regime (event_regime.c), the contact regime
  * (contact_regime.c); the rule that picks one is regime.c's, the islands are islands.c's. */
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 #include "world.h"
 #include "contact_regime.h"
@@ -10,6 +11,30 @@
 #include "islands.h"
 #include "regime.h"
 #include "tunables.h"
+
+struct lc_step_state {
+    lc_buf start, marks0;         /* the state and w->rests_dissipative the step began with */
+    lc_buf force_event;           /* rows an earlier try sends to the event regime (lc_step_try) */
+    lc_buf reach, reach_boxes;    /* where the tries' bodies went; a try's swept boxes */
+    lc_buf pairs;                 /* the pairs of those boxes */
+    lc_buf event_rows, excluded;  /* a try's event rows, and its contact islands' rows (w->excluded) */
+};
+
+lc_step_state *lc_step_state_create(void) { return calloc(1, sizeof(lc_step_state)); }
+
+void lc_step_state_destroy(lc_step_state *ss)
+{
+    if (ss == NULL) return;
+    lc_buf_free(&ss->start);
+    lc_buf_free(&ss->marks0);
+    lc_buf_free(&ss->force_event);
+    lc_buf_free(&ss->reach);
+    lc_buf_free(&ss->reach_boxes);
+    lc_buf_free(&ss->pairs);
+    lc_buf_free(&ss->event_rows);
+    lc_buf_free(&ss->excluded);
+    free(ss);
+}
 
 lc_status lc_step_undo(lc_world *w, const lc_step_try *step, lc_status s, const char *what)
 {
@@ -24,10 +49,10 @@ lc_status lc_step_undo(lc_world *w, const lc_step_try *step, lc_status s, const 
  * (start and end poses, the bulge of their turn, contact_distance) overlap another body's where the
  * build had no pair, so a contact between them could have been missed. Their swept boxes are added to
  * `reach` for the next try. Returns how many pairs that was, or -1 without memory. */
-static int unforeseen_pairs(lc_world *w, const double *backup, double *reach)
+static int unforeseen_pairs(lc_world *w, lc_step_state *ss, const double *backup, double *reach)
 {
     int n = w->count, i, np, found = 0, outside = 0;
-    double *boxes = lc_buf_get(&w->b_reach_boxes, (size_t)n * 4 * sizeof(double));
+    double *boxes = lc_buf_get(&ss->reach_boxes, (size_t)n * 4 * sizeof(double));
     const double *built = lc_islands_boxes(w->islands);
     const int *pairs;
     if (boxes == NULL) return -1;
@@ -40,9 +65,9 @@ static int unforeseen_pairs(lc_world *w, const double *backup, double *reach)
     }
     /* every path inside the box its island was built with: the build's pairs hold every meeting */
     if (!outside) return 0;
-    np = lc_broad_phase_boxes(w, boxes, &w->b_pairs);
+    np = lc_broad_phase_boxes(w, boxes, &ss->pairs);
     if (np < 0) return -1;
-    pairs = (const int *)w->b_pairs.p;
+    pairs = (const int *)ss->pairs.p;
     for (i = 0; i < np; ++i) {
         int a = pairs[2 * i], b = pairs[2 * i + 1], q;
         if (lc_islands_has_pair(w->islands, a, b)) continue;
@@ -87,8 +112,8 @@ static lc_status contact_island(lc_world *w, const lc_step_try *step, const lc_i
 static lc_status advance_islands(lc_world *w, const lc_step_try *step, double dt, const double *reach,
                                  int *marks_known, int *stuck)
 {
-    int *event_rows = lc_buf_get(&w->b_event_rows, (size_t)w->count * sizeof(int));
-    uint8_t *excluded = lc_buf_get(&w->b_excluded, (size_t)w->count);
+    int *event_rows = lc_buf_get(&w->step_state->event_rows, (size_t)w->count * sizeof(int));
+    uint8_t *excluded = lc_buf_get(&w->step_state->excluded, (size_t)w->count);
     int n_event = 0, k, i, any_contact = 0;
     double t0 = step->time0;
     lc_status st;
@@ -163,11 +188,13 @@ lc_status lc_world_step(lc_world *w, double dt)
 {
     size_t bytes;
     double *backup, *reach = NULL, time0;
-    uint8_t *marks0;
+    uint8_t *marks0, *force_event;
     int i, try, marks_known = 0;
     lc_status st;
     lc_step_try step;
+    lc_step_state *ss;
     if (w == NULL) return LC_ERR_NULL;
+    ss = w->step_state;
     if (!isfinite(dt)) return lc_fail(w, LC_ERR_NOT_FINITE, "dt is not finite (%g)", dt);
     if (!(dt > 0.0) || dt > 1.0) return lc_fail(w, LC_ERR_OUT_OF_RANGE, "dt = %g is outside (0, 1] s", dt);
     memset(&w->last, 0, sizeof w->last);
@@ -177,11 +204,11 @@ lc_status lc_world_step(lc_world *w, double dt)
     w->contact_count = 0;
     time0 = w->time;
     bytes = (size_t)(w->count > 0 ? w->count : 1) * 6 * sizeof(double);
-    backup = lc_buf_get(&w->b_backup, bytes);
-    marks0 = lc_buf_get(&w->b_marks0, (size_t)(w->count > 0 ? w->count : 1));
-    w->force_event = lc_buf_get(&w->b_force_event, (size_t)(w->count > 0 ? w->count : 1));
-    if (!backup || !marks0 || !w->force_event) return lc_fail(w, LC_ERR_NO_MEMORY, "out of memory in step");
-    memset(w->force_event, 0, (size_t)(w->count > 0 ? w->count : 1));
+    backup = lc_buf_get(&ss->start, bytes);
+    marks0 = lc_buf_get(&ss->marks0, (size_t)(w->count > 0 ? w->count : 1));
+    force_event = lc_buf_get(&ss->force_event, (size_t)(w->count > 0 ? w->count : 1));
+    if (!backup || !marks0 || !force_event) return lc_fail(w, LC_ERR_NO_MEMORY, "out of memory in step");
+    memset(force_event, 0, (size_t)(w->count > 0 ? w->count : 1));
     if (w->count == 0) {
         /* nothing to move: time still passes */
         w->time += dt;
@@ -193,7 +220,7 @@ lc_status lc_world_step(lc_world *w, double dt)
     memcpy(backup, w->state, (size_t)w->count * 6 * sizeof(double));
     step.start = backup;
     step.time0 = time0;
-    step.force_event = w->force_event;
+    step.force_event = force_event;
     if (lc_regime_refresh(w) != 0 || lc_contact_regime_begin_step(w->contact) != 0)
         return lc_step_undo(w, &step, LC_ERR_NO_MEMORY, "out of memory during the step");
     memcpy(marks0, w->rests_dissipative, (size_t)w->count);
@@ -210,19 +237,19 @@ lc_status lc_world_step(lc_world *w, double dt)
         }
         if (try < LC_MAX_ISLAND_TRIES - 1) {
             if (reach == NULL) {
-                reach = lc_buf_get(&w->b_reach, (size_t)w->count * 4 * sizeof(double));
+                reach = lc_buf_get(&ss->reach, (size_t)w->count * 4 * sizeof(double));
                 if (reach == NULL) return lc_step_undo(w, &step, LC_ERR_NO_MEMORY, "out of memory during the step");
                 for (i = 0; i < w->count; ++i) {
                     reach[4 * i] = 1.0;
                     reach[4 * i + 2] = -1.0;
                 }
             }
-            found = unforeseen_pairs(w, backup, reach);
+            found = unforeseen_pairs(w, ss, backup, reach);
             if (found < 0) return lc_step_undo(w, &step, LC_ERR_NO_MEMORY, "out of memory during the step");
         }
         if (found == 0 && stuck) {
             lc_island isl = lc_islands_get(w->islands, stuck - 1);
-            for (i = 0; i < isl.nrows; ++i) w->force_event[isl.rows[i]] = 1;
+            for (i = 0; i < isl.nrows; ++i) force_event[isl.rows[i]] = 1;
             --try;
         } else if (found == 0) {
             break;

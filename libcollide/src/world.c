@@ -199,7 +199,8 @@ lc_world *lc_world_create(const lc_world_def *def, char *errbuf, size_t errbuf_l
         w->islands = lc_islands_create();
         w->contact = lc_contact_regime_create();
         w->event = lc_event_regime_create();
-        if (w->lcp == NULL || w->islands == NULL || w->contact == NULL || w->event == NULL)
+        w->step_state = lc_step_state_create();
+        if (w->lcp == NULL || w->islands == NULL || w->contact == NULL || w->event == NULL || w->step_state == NULL)
             s = lc_fail(w, LC_ERR_NO_MEMORY, "out of memory");
     }
     if (s != LC_OK) {
@@ -224,12 +225,9 @@ void lc_world_destroy(lc_world *w)
     free(w->springs); free(w->contacts); free(w->rests_dissipative);
     lc_lcp_workspace_destroy(w->lcp);
     lc_islands_destroy(w->islands);
-    lc_buf_free(&w->b_event_rows); lc_buf_free(&w->b_excluded);
-    lc_buf_free(&w->b_marks0); lc_buf_free(&w->b_reach); lc_buf_free(&w->b_reach_boxes);
-    lc_buf_free(&w->b_force_event);
+    lc_step_state_destroy(w->step_state);
     lc_contact_regime_destroy(w->contact);
     lc_event_regime_destroy(w->event);
-    lc_buf_free(&w->b_backup);
     for (i = 0; i < 4; ++i) lc_buf_free(&w->b_k[i]);
     lc_buf_free(&w->b_tmp); lc_buf_free(&w->b_acc); lc_buf_free(&w->b_touch); lc_buf_free(&w->b_rest);
     lc_buf_free(&w->b_pairs); lc_buf_free(&w->b_aabb); lc_buf_free(&w->b_island);

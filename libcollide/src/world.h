@@ -100,15 +100,15 @@ struct lc_world {
     struct lc_contact_regime *contact;   /* contact_regime.c */
     struct lc_event_regime *event;       /* event_regime.c */
     unsigned long regime_edits;          /* regime.c: `edits` when rests_dissipative last described the state */
-    const uint8_t *excluded;             /* step.c: dynamic rows left out of every pair (other islands) */
-    lc_buf b_event_rows, b_excluded;     /* step.c */
-    lc_buf b_marks0, b_reach, b_reach_boxes; /* step.c: rests_dissipative at the start, the tries' reach */
-    lc_buf b_force_event;
-    uint8_t *force_event;                /* step.c: rows an earlier try of this step sends to the event regime */
+    struct lc_step_state *step_state;    /* step.c */
+    /* dynamic rows the broad phase and the event regime leave out of every pair while the event regime
+     * advances the other islands (step.c sets it, broad_phase.c and event_touches.c read it; the broad
+     * phase's interface is shared with regime.c and islands.c, which never set it) */
+    const uint8_t *excluded;
 
     /* scratch, reused between steps */
     lc_lcp_workspace *lcp;
-    lc_buf b_backup, b_k[4], b_tmp, b_acc;
+    lc_buf b_k[4], b_tmp, b_acc;
     lc_buf b_touch, b_rest, b_pairs, b_aabb, b_island, b_flags, b_mat, b_vec, b_vec2, b_order;
     lc_buf b_marked_rows;    /* broad_phase.c: the marked rows of lc_broad_phase_of in row order */
     lc_buf b_have_box, b_bound_boxes; /* broad_phase.c: lc_broad_phase_of's computed boxes, bounds */
@@ -271,6 +271,9 @@ int lc_resolve_impacts(lc_world *w, double *state, lc_touch *t, int n, int elast
 double lc_bounce_speed(const lc_world *w, double elasticity);
 
 /* ---- step.c ---- */
+typedef struct lc_step_state lc_step_state;   /* the step's own buffers, owned by the world */
+lc_step_state *lc_step_state_create(void);
+void lc_step_state_destroy(lc_step_state *ss);
 /* The try at the step in progress, as the regimes see it: where it began (to undo it, or to weigh its
  * energy against), and the rows an earlier try sent to the event regime. */
 typedef struct lc_step_try {
