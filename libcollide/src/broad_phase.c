@@ -7,6 +7,31 @@
 
 typedef struct box { double x0, y0, x1, y1; int row; } box;
 
+struct lc_broad_phase_state {
+    lc_buf boxes;                  /* every body's box of a search, by row */
+    lc_buf bounds, have, marked;   /* lc_broad_phase_of: cheap bounds, which boxes it computed, its rows sorted */
+    /* the rows in the last sort-and-sweep's x order (sweep_rows of them), the boxes being sorted, and the
+     * counting sort of the pairs */
+    lc_buf sweep_order, sweep_boxes, pair_start, pair_tmp;
+    int sweep_rows;
+};
+
+lc_broad_phase_state *lc_broad_phase_state_create(void) { return calloc(1, sizeof(lc_broad_phase_state)); }
+
+void lc_broad_phase_state_destroy(lc_broad_phase_state *bp)
+{
+    if (bp == NULL) return;
+    lc_buf_free(&bp->boxes);
+    lc_buf_free(&bp->bounds);
+    lc_buf_free(&bp->have);
+    lc_buf_free(&bp->marked);
+    lc_buf_free(&bp->sweep_order);
+    lc_buf_free(&bp->sweep_boxes);
+    lc_buf_free(&bp->pair_start);
+    lc_buf_free(&bp->pair_tmp);
+    free(bp);
+}
+
 static void body_box(const lc_world *w, const double *s, int row, box *b)
 {
     const lc_shape *sh = &w->shape[row];
@@ -92,12 +117,13 @@ static int cmp_box(const void *x, const void *y)
  * or NULL without memory. */
 static box *sweep_sorted(lc_world *w, const box *by_row, int n)
 {
-    int *order = lc_buf_get(&w->b_sweep_order, (size_t)n * sizeof(int));
-    box *b = lc_buf_get(&w->b_sweep_boxes, (size_t)n * sizeof(box));
+    lc_broad_phase_state *bp = w->broad_phase;
+    int *order = lc_buf_get(&bp->sweep_order, (size_t)n * sizeof(int));
+    box *b = lc_buf_get(&bp->sweep_boxes, (size_t)n * sizeof(box));
     long moves = 0, limit = 8L * n + 64;
     int i, finite = 1;
     if (order == NULL || b == NULL) return NULL;
-    if (w->sweep_rows != n)
+    if (bp->sweep_rows != n)
         for (i = 0; i < n; ++i) order[i] = i;
     for (i = 0; i < n; ++i) {
         b[i] = by_row[order[i]];
@@ -118,7 +144,7 @@ static box *sweep_sorted(lc_world *w, const box *by_row, int n)
     }
     if (!finite || moves > limit) qsort(b, (size_t)n, sizeof(box), cmp_box);
     for (i = 0; i < n; ++i) order[i] = b[i].row;
-    w->sweep_rows = n;
+    bp->sweep_rows = n;
     return b;
 }
 
@@ -141,8 +167,8 @@ static void pairs_by(const int *from, int *to, int count, int key, int *start, i
  * -1 without memory. */
 static int order_pairs(lc_world *w, int *p, int count)
 {
-    int *start = lc_buf_get(&w->b_pair_start, (size_t)(w->count + 1) * sizeof(int));
-    int *q = lc_buf_get(&w->b_pair_tmp, (size_t)count * 2 * sizeof(int));
+    int *start = lc_buf_get(&w->broad_phase->pair_start, (size_t)(w->count + 1) * sizeof(int));
+    int *q = lc_buf_get(&w->broad_phase->pair_tmp, (size_t)count * 2 * sizeof(int));
     if (start == NULL || q == NULL) return -1;
     pairs_by(p, q, count, 1, start, w->count);
     pairs_by(q, p, count, 0, start, w->count);
@@ -169,7 +195,7 @@ static void swept_box(lc_world *w, const double *s0, const double *s1, int i, do
 static box *swept_boxes(lc_world *w, const double *s0, const double *s1, double margin)
 {
     int n = w->count, i;
-    box *boxes = lc_buf_get(&w->b_aabb, (size_t)(n > 0 ? n : 1) * sizeof(box));
+    box *boxes = lc_buf_get(&w->broad_phase->boxes, (size_t)(n > 0 ? n : 1) * sizeof(box));
     if (boxes == NULL) return NULL;
     for (i = 0; i < n; ++i) swept_box(w, s0, s1, i, margin, &boxes[i]);
     return boxes;
@@ -237,7 +263,7 @@ void lc_swept_box(lc_world *w, const double *s0, const double *s1, int row, doub
 int lc_broad_phase_boxes(lc_world *w, const double *boxes4, lc_buf *buf)
 {
     int n = w->count, i;
-    box *boxes = lc_buf_get(&w->b_aabb, (size_t)(n > 0 ? n : 1) * sizeof(box));
+    box *boxes = lc_buf_get(&w->broad_phase->boxes, (size_t)(n > 0 ? n : 1) * sizeof(box));
     if (boxes == NULL) return -1;
     for (i = 0; i < n; ++i) {
         boxes[i].x0 = boxes4[4 * i];
@@ -253,10 +279,11 @@ int lc_broad_phase_of(lc_world *w, const double *s0, const double *s1, double ma
                       const int *list, int nlist, lc_buf *buf)
 {
     int n = w->count, a, b, k, first = 0, count = 0;
-    box *boxes = lc_buf_get(&w->b_aabb, (size_t)(n > 0 ? n : 1) * sizeof(box));
-    box *bounds = lc_buf_get(&w->b_bound_boxes, (size_t)(n > 0 ? n : 1) * sizeof(box));
-    uint8_t *have = lc_buf_get(&w->b_have_box, (size_t)(n > 0 ? n : 1));
-    int *sorted = lc_buf_get(&w->b_marked_rows, (size_t)(nlist > 0 ? nlist : 1) * sizeof(int));
+    lc_broad_phase_state *bp = w->broad_phase;
+    box *boxes = lc_buf_get(&bp->boxes, (size_t)(n > 0 ? n : 1) * sizeof(box));
+    box *bounds = lc_buf_get(&bp->bounds, (size_t)(n > 0 ? n : 1) * sizeof(box));
+    uint8_t *have = lc_buf_get(&bp->have, (size_t)(n > 0 ? n : 1));
+    int *sorted = lc_buf_get(&bp->marked, (size_t)(nlist > 0 ? nlist : 1) * sizeof(int));
     if (boxes == NULL || bounds == NULL || have == NULL || sorted == NULL) return -1;
     /* The listed rows' boxes now; another body's only when it could be near one of them. After an
      * impact every body has moved to the impact's time, and computing all their boxes again (a

@@ -1,8 +1,33 @@
 /* Resting contact forces (Baraff): relative normal accelerations a = A f + b with f >= 0, a >= 0,
  * f.a = 0, solved per group of touches that share moving bodies. */
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 #include "world.h"
+
+struct lc_contact_forces_state {
+    lc_buf groups, sub;       /* the union-find and the touches in group order; one group's touches */
+    lc_buf mat, vec, vec2;    /* a small group's response matrix, right-hand side and forces */
+    lc_buf fric;              /* a small friction group's normal and tangent blocks */
+    lc_buf rows;              /* a large group's right-hand sides, bounds and forces */
+    lc_buf body;              /* per-body responses of a sparse product (count x 3) */
+};
+
+lc_contact_forces_state *lc_contact_forces_state_create(void) { return calloc(1, sizeof(lc_contact_forces_state)); }
+
+void lc_contact_forces_state_destroy(lc_contact_forces_state *cf)
+{
+    if (cf == NULL) return;
+    lc_buf_free(&cf->groups);
+    lc_buf_free(&cf->sub);
+    lc_buf_free(&cf->mat);
+    lc_buf_free(&cf->vec);
+    lc_buf_free(&cf->vec2);
+    lc_buf_free(&cf->fric);
+    lc_buf_free(&cf->rows);
+    lc_buf_free(&cf->body);
+    free(cf);
+}
 
 /* Union-find over body rows; static bodies never join groups (they do not transmit motion). */
 static int find(int *parent, int x)
@@ -117,9 +142,9 @@ static int solve_with_friction(lc_world *w, const double *state, lc_touch *sub, 
                                double kv, double kd, double h, const lc_lcp_options *opt)
 {
     int i, outer;
-    double *v = lc_buf_get(&w->b_vec, (size_t)m * 10 * sizeof(double));
-    double *Ann = lc_buf_get(&w->b_cfric, (size_t)m * (size_t)m * sizeof(double));
-    double *body = lc_buf_get(&w->b_dacc, (size_t)w->count * 3 * sizeof(double));
+    double *v = lc_buf_get(&w->contact_forces->vec, (size_t)m * 10 * sizeof(double));
+    double *Ann = lc_buf_get(&w->contact_forces->fric, (size_t)m * (size_t)m * sizeof(double));
+    double *body = lc_buf_get(&w->contact_forces->body, (size_t)w->count * 3 * sizeof(double));
     double *b_n, *b_t, *fn, *ft, *bn, *bt, *lo, *hi, *fold, *moved, viol = 0.0;
     double prev_change = -1.0, prev_rho = -1.0, inner, change = 0.0;
     /* a hundredth of the large groups' tolerance (see solve_large_group): at 2.5e-4 contact_gap / h^2
@@ -227,8 +252,8 @@ static int solve_with_friction(lc_world *w, const double *state, lc_touch *sub, 
 static int solve_large_group(lc_world *w, const double *state, lc_touch *sub, int m, const double *acc, double kv,
                              double kd, double h, int with_friction, double *resid)
 {
-    double *v = lc_buf_get(&w->b_group_rows, (size_t)m * 8 * sizeof(double));
-    double *body = lc_buf_get(&w->b_dacc, (size_t)w->count * 3 * sizeof(double));
+    double *v = lc_buf_get(&w->contact_forces->rows, (size_t)m * 8 * sizeof(double));
+    double *body = lc_buf_get(&w->contact_forces->body, (size_t)w->count * 3 * sizeof(double));
     double *bn, *bt, *fn, *ft, *lo, *hi, *rhs, *ft_old, tol, inner, viol = 0.0, tviol = 0.0, prev_moved = -1.0;
     int i, round, k, products = 0, budget = 5 * w->def.lcp_max_iterations;
     if (v == NULL || body == NULL) return -1;
@@ -308,7 +333,7 @@ static int contact_forces(lc_world *w, const double *state, lc_touch *touches, i
     /* the exact solve of a small group starts from the active set of the touches' previous forces */
     opt.warm_start = 1;
 
-    parent = lc_buf_get(&w->b_island, (size_t)(2 * rows + 1 + 2 * n) * sizeof(int));
+    parent = lc_buf_get(&w->contact_forces->groups, (size_t)(2 * rows + 1 + 2 * n) * sizeof(int));
     if (parent == NULL) return -1;
     order = parent + rows;
     group = order + n;
@@ -340,10 +365,11 @@ static int contact_forces(lc_world *w, const double *state, lc_touch *touches, i
         lc_lcp_result res;
         while (g1 < n && group[order[g1]] == group[order[g0]]) ++g1;
         m = g1 - g0;
-        sub = lc_buf_get(&w->b_rest, (size_t)m * sizeof(lc_touch));
-        A = lc_buf_get(&w->b_mat, m > w->def.lcp_exact_max ? sizeof(double) : (size_t)m * (size_t)m * sizeof(double));
-        b = lc_buf_get(&w->b_vec, (size_t)m * sizeof(double));
-        f = lc_buf_get(&w->b_vec2, (size_t)m * sizeof(double));
+        sub = lc_buf_get(&w->contact_forces->sub, (size_t)m * sizeof(lc_touch));
+        A = lc_buf_get(&w->contact_forces->mat,
+                       m > w->def.lcp_exact_max ? sizeof(double) : (size_t)m * (size_t)m * sizeof(double));
+        b = lc_buf_get(&w->contact_forces->vec, (size_t)m * sizeof(double));
+        f = lc_buf_get(&w->contact_forces->vec2, (size_t)m * sizeof(double));
         if (!sub || !A || !b || !f) return -1;
         for (j = 0; j < m; ++j) sub[j] = touches[order[g0 + j]];
         {

@@ -9,8 +9,29 @@
  * a face arriving at different speeds gain up to a few percent per hit. For one point both are
  * eq. 11: j = -(1 + e) v_n / (n.A n). */
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 #include "world.h"
+
+struct lc_impulse_state {
+    lc_buf mat, vec, vec2;    /* a dense impact's response matrix, right-hand side and impulses */
+    lc_buf fric, coupled;     /* the friction rows of an impact, and which of them are coupled */
+    lc_buf body;              /* per-body responses of a sparse product (count x 3) */
+};
+
+lc_impulse_state *lc_impulse_state_create(void) { return calloc(1, sizeof(lc_impulse_state)); }
+
+void lc_impulse_state_destroy(lc_impulse_state *is)
+{
+    if (is == NULL) return;
+    lc_buf_free(&is->mat);
+    lc_buf_free(&is->vec);
+    lc_buf_free(&is->vec2);
+    lc_buf_free(&is->fric);
+    lc_buf_free(&is->coupled);
+    lc_buf_free(&is->body);
+    free(is);
+}
 
 /* Approach speed (m/s) above which an impact at this touch bounces: restitution_threshold, not below
  * resting_speed. Perfectly elastic pairs (e >= 1) bounce down to resting_speed, so energy is kept
@@ -39,9 +60,9 @@ static int solve_block_friction(lc_world *w, double *state, lc_touch *t, int n, 
                                 int restitute, const lc_lcp_options *opt)
 {
     int n2 = 2 * n, i, k, hits = 0;
-    double *A = lc_buf_get(&w->b_mat, (size_t)n2 * (size_t)n2 * sizeof(double));
-    double *b = lc_buf_get(&w->b_fric, (size_t)n2 * 3 * sizeof(double));
-    int *coupled = lc_buf_get(&w->b_order, (size_t)n2 * sizeof(int));
+    double *A = lc_buf_get(&w->impulse->mat, (size_t)n2 * (size_t)n2 * sizeof(double));
+    double *b = lc_buf_get(&w->impulse->fric, (size_t)n2 * 3 * sizeof(double));
+    int *coupled = lc_buf_get(&w->impulse->coupled, (size_t)n2 * sizeof(int));
     double *j, *mu;
     lc_lcp_options o = *opt;
     lc_lcp_result res;
@@ -122,8 +143,8 @@ static void clip_to_cone(const lc_touch *t, int n, const double *jn, double *jt)
  * resting test treats as at rest. */
 static int solve_block_sparse(lc_world *w, double *state, lc_touch *t, int n, int restitute)
 {
-    double *v = lc_buf_get(&w->b_fric, (size_t)n * 8 * sizeof(double));
-    double *body = lc_buf_get(&w->b_dacc, (size_t)w->count * 3 * sizeof(double));
+    double *v = lc_buf_get(&w->impulse->fric, (size_t)n * 8 * sizeof(double));
+    double *body = lc_buf_get(&w->impulse->body, (size_t)w->count * 3 * sizeof(double));
     double *jn, *jt, *vn0, *vt0, *lo, *hi, *rhs, *jt_old, tol, viol = 0.0;
     int i, round, k, hits = 0, with_friction = 0, budget = 5 * w->def.lcp_max_iterations;
     if (v == NULL || body == NULL) return -1;
@@ -198,9 +219,9 @@ static int solve_block(lc_world *w, double *state, lc_touch *t, int n, int use_e
             if (use_e && normal_velocity(state, &t[i]) < -bounce_speed(w, &t[i])) restitute = 1;
         return solve_block_sparse(w, state, t, n, restitute);
     }
-    A = lc_buf_get(&w->b_mat, (size_t)n * (size_t)n * sizeof(double));
-    b = lc_buf_get(&w->b_vec, (size_t)n * sizeof(double));
-    j = lc_buf_get(&w->b_vec2, (size_t)n * sizeof(double));
+    A = lc_buf_get(&w->impulse->mat, (size_t)n * (size_t)n * sizeof(double));
+    b = lc_buf_get(&w->impulse->vec, (size_t)n * sizeof(double));
+    j = lc_buf_get(&w->impulse->vec2, (size_t)n * sizeof(double));
     if (!A || !b || !j) return -1;
     opt = lc_lcp_default_options();
     opt.exact_max = w->def.lcp_exact_max;

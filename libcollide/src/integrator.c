@@ -1,8 +1,28 @@
 /* Time integration between impacts: closed form for bodies under constant forces, otherwise the
  * world's explicit integrator (Euler, midpoint or RK4) with resting contact forces in every evaluation. */
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 #include "world.h"
+
+struct lc_integrator_state {
+    lc_buf flags, rows;      /* rows in a resting touch; the rows advanced by the integrator */
+    lc_buf acc, tmp, k[4];   /* accelerations, and the stages' states and derivatives (count x 6) */
+};
+
+lc_integrator_state *lc_integrator_state_create(void) { return calloc(1, sizeof(lc_integrator_state)); }
+
+void lc_integrator_state_destroy(lc_integrator_state *is)
+{
+    int i;
+    if (is == NULL) return;
+    lc_buf_free(&is->flags);
+    lc_buf_free(&is->rows);
+    lc_buf_free(&is->acc);
+    lc_buf_free(&is->tmp);
+    for (i = 0; i < 4; ++i) lc_buf_free(&is->k[i]);
+    free(is);
+}
 
 /* Derivative of the listed rows: d/dt (x, y, a, vx, vy, w) = (vx, vy, w, ax, ay, alpha). */
 static int derivative(lc_world *w, const double *s, const int *rows, int n, lc_touch *t, int nt,
@@ -113,9 +133,9 @@ static int integrate(lc_world *w, const double *s0, double h, const int *rows, i
     int *flags, *irows, ni = 0, i;
     double *acc, *tmp, *k1, *k2, *k3, *k4;
     if (w->count == 0) return 0;
-    flags = lc_buf_get(&w->b_flags, (size_t)w->count * sizeof(int));
-    irows = lc_buf_get(&w->b_irows, (size_t)(nrows > 0 ? nrows : 1) * sizeof(int));
-    acc = lc_buf_get(&w->b_acc, (size_t)w->count * 3 * sizeof(double));
+    flags = lc_buf_get(&w->integrator->flags, (size_t)w->count * sizeof(int));
+    irows = lc_buf_get(&w->integrator->rows, (size_t)(nrows > 0 ? nrows : 1) * sizeof(int));
+    acc = lc_buf_get(&w->integrator->acc, (size_t)w->count * 3 * sizeof(double));
     if (!flags || !irows || !acc) return -1;
     if (s1 != s0 && copy_all) memcpy(s1, s0, bytes);
     /* a moving row is written whole below when time passes; a static one only here */
@@ -136,11 +156,11 @@ static int integrate(lc_world *w, const double *s0, double h, const int *rows, i
         }
     }
     if (ni == 0) return 0;
-    tmp = lc_buf_get(&w->b_tmp, bytes);
-    k1 = lc_buf_get(&w->b_k[0], bytes);
-    k2 = lc_buf_get(&w->b_k[1], bytes);
-    k3 = lc_buf_get(&w->b_k[2], bytes);
-    k4 = lc_buf_get(&w->b_k[3], bytes);
+    tmp = lc_buf_get(&w->integrator->tmp, bytes);
+    k1 = lc_buf_get(&w->integrator->k[0], bytes);
+    k2 = lc_buf_get(&w->integrator->k[1], bytes);
+    k3 = lc_buf_get(&w->integrator->k[2], bytes);
+    k4 = lc_buf_get(&w->integrator->k[3], bytes);
     if (!tmp || !k1 || !k2 || !k3 || !k4) return -1;
     /* tmp holds every row (others constant during the step) so springs and contacts can read them */
     memcpy(tmp, s0, bytes);

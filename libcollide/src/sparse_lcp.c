@@ -9,8 +9,29 @@
  * A product A x costs O(rows + bodies): each row's push is spread onto its two bodies, then read
  * back along each row's direction (response.c). */
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 #include "world.h"
+
+struct lc_sparse_lcp_state {
+    lc_buf vectors, body, rows;  /* a solve's vectors, the bodies' responses of a product, its rows */
+    /* the last ||A|| estimate of normal [0] and tangent [1] rows, and their row count: a pile's A changes
+     * little from one solve to the next, whichever module solves (contact forces, projections, the
+     * contact regime), so the estimate is the module's, kept across solves */
+    double norm[2];
+    int norm_rows[2];
+};
+
+lc_sparse_lcp_state *lc_sparse_lcp_state_create(void) { return calloc(1, sizeof(lc_sparse_lcp_state)); }
+
+void lc_sparse_lcp_state_destroy(lc_sparse_lcp_state *sp)
+{
+    if (sp == NULL) return;
+    lc_buf_free(&sp->vectors);
+    lc_buf_free(&sp->body);
+    lc_buf_free(&sp->rows);
+    free(sp);
+}
 
 /* Entries of A = J M^-1 J^T one row of a product visits: a touch's row of J has 6 (3 per body), read
  * once in J^T x and once in J; the unit of lc_counters.solver_work (a dense pivot visits m per row). */
@@ -205,8 +226,9 @@ static double feasible_step(const double *x, const double *d, const double *lo, 
 int lc_sparse_lcp(lc_world *w, const lc_touch *t, int m, int tangent, const double *b, const double *lo,
                   const double *hi, double *x, double tol, int max_products, double *violation)
 {
-    double *body = lc_buf_get(&w->b_sparse_body, (size_t)w->count * 3 * sizeof(double));
-    double *g = lc_buf_get(&w->b_sparse, (size_t)m * 7 * sizeof(double));
+    lc_sparse_lcp_state *sp = w->sparse_lcp;
+    double *body = lc_buf_get(&sp->body, (size_t)w->count * 3 * sizeof(double));
+    double *g = lc_buf_get(&sp->vectors, (size_t)m * 7 * sizeof(double));
     double *p, *ap, *phi, *beta, *d, *kept, alpha, lambda, worst, kept_worst, bb, pp;
     sparse_row *rows;
     int i, products = 0, restarted = 0, refreshed = 0;
@@ -215,7 +237,7 @@ int lc_sparse_lcp(lc_world *w, const lc_touch *t, int m, int tangent, const doub
         *violation = 0.0;
         return 0;
     }
-    rows = lc_buf_get(&w->b_sparse_rows, (size_t)m * sizeof(sparse_row));
+    rows = lc_buf_get(&sp->rows, (size_t)m * sizeof(sparse_row));
     if (rows == NULL) return -1;
     prepare_rows(w, t, m, tangent, rows);
     p = g + m;
@@ -224,14 +246,14 @@ int lc_sparse_lcp(lc_world *w, const lc_touch *t, int m, int tangent, const doub
     beta = phi + m;
     d = beta + m;
     kept = d + m;
-    if (w->sparse_norm_rows[tangent != 0] == m) {
-        lambda = w->sparse_norm[tangent != 0];
+    if (sp->norm_rows[tangent != 0] == m) {
+        lambda = sp->norm[tangent != 0];
     } else {
         lambda = norm_estimate(w, rows, m, LC_MPRGP_POWER_ITERATIONS, p, ap, body);
         products += LC_MPRGP_POWER_ITERATIONS;
         refreshed = 1;
-        w->sparse_norm[tangent != 0] = lambda;
-        w->sparse_norm_rows[tangent != 0] = m;
+        sp->norm[tangent != 0] = lambda;
+        sp->norm_rows[tangent != 0] = m;
     }
     if (!(lambda > 0.0) || !isfinite(lambda)) {
         /* a row with a positive diagonal entry: A is not 0 after all, and its largest diagonal entry
@@ -325,7 +347,7 @@ int lc_sparse_lcp(lc_world *w, const lc_touch *t, int m, int tangent, const doub
                     if (fresh > lambda && isfinite(fresh)) {
                         lambda = fresh;
                         alpha = 1.8 / lambda;
-                        w->sparse_norm[tangent != 0] = lambda;
+                        sp->norm[tangent != 0] = lambda;
                     }
                 }
                 worst = gradients(x, g, lo, hi, m, alpha, phi, beta, &bb, &pp);

@@ -15,8 +15,23 @@
  * Bodies on a cycle of such touches (possible only with odd shapes) are done last in row order: the
  * guess is only a start, the solve corrects it. Without gravity there is no up and no guess. */
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 #include "world.h"
+
+struct lc_static_load_state {
+    lc_buf loads, graph;   /* per-body loads (or lifts), and the graph of who rests on whom */
+};
+
+lc_static_load_state *lc_static_load_state_create(void) { return calloc(1, sizeof(lc_static_load_state)); }
+
+void lc_static_load_state_destroy(lc_static_load_state *sl)
+{
+    if (sl == NULL) return;
+    lc_buf_free(&sl->loads);
+    lc_buf_free(&sl->graph);
+    free(sl);
+}
 
 /* cos 60 degrees: steeper touches (walls, the sides of boxes) carry no guessed load */
 #define LC_SUPPORT_COS 0.5
@@ -58,7 +73,7 @@ typedef struct support_graph {
 static int build_graph(lc_world *w, const lc_touch *t, int m, lc_vec2 up, const nodes *nd, support_graph *g)
 {
     int n = nd->n, i, head = 0;
-    int *mem = lc_buf_get(&w->b_load_graph, ((size_t)n * 3 + 1 + (size_t)m) * sizeof(int));
+    int *mem = lc_buf_get(&w->static_load->graph, ((size_t)n * 3 + 1 + (size_t)m) * sizeof(int));
     if (mem == NULL) return -1;
     g->first = mem;
     g->pending = mem + n + 1;
@@ -174,7 +189,7 @@ static int load_forces(lc_world *w, const lc_touch *t, int m, const nodes *nd, d
     int i;
     if (!up_direction(w, &up)) return 0;
     if (build_graph(w, t, m, up, nd, &g) != 0) return -1;
-    load = lc_buf_get(&w->b_load, (size_t)(nd->n > 0 ? nd->n : 1) * 2 * sizeof(double));
+    load = lc_buf_get(&w->static_load->loads, (size_t)(nd->n > 0 ? nd->n : 1) * 2 * sizeof(double));
     if (load == NULL) return -1;
     for (i = 0; i < nd->n; ++i) {
         int r = row_of_node(nd, i);
@@ -216,7 +231,7 @@ int lc_static_load_lifts(lc_world *w, const lc_touch *t, int m, const double *de
     nd.n = w->count;
     if (!up_direction(w, &up)) return 0;
     if (build_graph(w, t, m, up, &nd, &g) != 0) return -1;
-    load = lc_buf_get(&w->b_load, (size_t)w->count * 2 * sizeof(double));
+    load = lc_buf_get(&w->static_load->loads, (size_t)w->count * 2 * sizeof(double));
     if (load == NULL) return -1;
     /* bottom up (the reverse order): a body must rise as far as the highest of its holders plus what
      * its own touch is short of the gap; as a load, that rise times its mass */

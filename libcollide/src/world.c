@@ -195,12 +195,19 @@ lc_world *lc_world_create(const lc_world_def *def, char *errbuf, size_t errbuf_l
     }
     s = validate_world_def(w, def);
     if (s == LC_OK) {
-        w->lcp = lc_lcp_workspace_create();
-        w->islands = lc_islands_create();
-        w->contact = lc_contact_regime_create();
-        w->event = lc_event_regime_create();
         w->step_state = lc_step_state_create();
-        if (w->lcp == NULL || w->islands == NULL || w->contact == NULL || w->event == NULL || w->step_state == NULL)
+        w->islands = lc_islands_create();
+        w->event = lc_event_regime_create();
+        w->contact = lc_contact_regime_create();
+        w->broad_phase = lc_broad_phase_state_create();
+        w->integrator = lc_integrator_state_create();
+        w->contact_forces = lc_contact_forces_state_create();
+        w->impulse = lc_impulse_state_create();
+        w->sparse_lcp = lc_sparse_lcp_state_create();
+        w->static_load = lc_static_load_state_create();
+        w->lcp = lc_lcp_workspace_create();
+        if (!w->step_state || !w->islands || !w->event || !w->contact || !w->broad_phase || !w->integrator ||
+            !w->contact_forces || !w->impulse || !w->sparse_lcp || !w->static_load || !w->lcp)
             s = lc_fail(w, LC_ERR_NO_MEMORY, "out of memory");
     }
     if (s != LC_OK) {
@@ -217,23 +224,24 @@ lc_world *lc_world_create(const lc_world_def *def, char *errbuf, size_t errbuf_l
 
 void lc_world_destroy(lc_world *w)
 {
-    int i;
     if (w == NULL) return;
     free(w->ids); free(w->state); free(w->mass); free(w->inertia); free(w->inv_mass); free(w->inv_inertia);
     free(w->is_static); free(w->elasticity); free(w->friction); free(w->ext_force); free(w->ext_torque);
     free(w->shape); free(w->trig); free(w->thrusters); free(w->thruster_count); free(w->id_to_row);
     free(w->springs); free(w->contacts); free(w->rests_dissipative);
-    lc_lcp_workspace_destroy(w->lcp);
-    lc_islands_destroy(w->islands);
     lc_step_state_destroy(w->step_state);
-    lc_contact_regime_destroy(w->contact);
+    lc_islands_destroy(w->islands);
     lc_event_regime_destroy(w->event);
-    for (i = 0; i < 4; ++i) lc_buf_free(&w->b_k[i]);
-    lc_buf_free(&w->b_tmp); lc_buf_free(&w->b_acc); lc_buf_free(&w->b_touch); lc_buf_free(&w->b_rest);
-    lc_buf_free(&w->b_pairs); lc_buf_free(&w->b_aabb); lc_buf_free(&w->b_island);
-    lc_buf_free(&w->b_flags); lc_buf_free(&w->b_mat); lc_buf_free(&w->b_vec); lc_buf_free(&w->b_vec2);
-    lc_buf_free(&w->b_marked_rows); lc_buf_free(&w->b_have_box); lc_buf_free(&w->b_bound_boxes); lc_buf_free(&w->b_sweep_order); lc_buf_free(&w->b_sweep_boxes); lc_buf_free(&w->b_pair_start); lc_buf_free(&w->b_pair_tmp); lc_buf_free(&w->b_sparse); lc_buf_free(&w->b_sparse_body); lc_buf_free(&w->b_sparse_rows); lc_buf_free(&w->b_group_rows); lc_buf_free(&w->b_load); lc_buf_free(&w->b_load_graph); lc_buf_free(&w->b_fric); lc_buf_free(&w->b_cfric); lc_buf_free(&w->b_order);
-    lc_buf_free(&w->b_irows); lc_buf_free(&w->b_dacc); lc_buf_free(&w->b_diag);
+    lc_contact_regime_destroy(w->contact);
+    lc_broad_phase_state_destroy(w->broad_phase);
+    lc_integrator_state_destroy(w->integrator);
+    lc_contact_forces_state_destroy(w->contact_forces);
+    lc_impulse_state_destroy(w->impulse);
+    lc_sparse_lcp_state_destroy(w->sparse_lcp);
+    lc_static_load_state_destroy(w->static_load);
+    lc_lcp_workspace_destroy(w->lcp);
+    lc_buf_free(&w->b_pairs);
+    lc_buf_free(&w->b_touch);
     free(w);
 }
 

@@ -96,36 +96,33 @@ struct lc_world {
 
     lc_counters last, total;
 
-    struct lc_islands *islands;          /* islands.c */
-    struct lc_contact_regime *contact;   /* contact_regime.c */
-    struct lc_event_regime *event;       /* event_regime.c */
-    unsigned long regime_edits;          /* regime.c: `edits` when rests_dissipative last described the state */
-    struct lc_step_state *step_state;    /* step.c */
+    /* The state each part of the engine keeps: buffers that grow to the largest problem seen and what it
+     * remembers from one step or solve to the next, each owned by its file, created and destroyed with
+     * the world (world.c). */
+    struct lc_step_state *step_state;               /* step.c */
+    struct lc_islands *islands;                     /* islands.c */
+    struct lc_event_regime *event;                  /* event_regime.c */
+    struct lc_contact_regime *contact;              /* contact_regime.c */
+    struct lc_broad_phase_state *broad_phase;       /* broad_phase.c */
+    struct lc_integrator_state *integrator;         /* integrator.c */
+    struct lc_contact_forces_state *contact_forces; /* contact_forces.c */
+    struct lc_impulse_state *impulse;               /* impulse.c */
+    struct lc_sparse_lcp_state *sparse_lcp;         /* sparse_lcp.c */
+    struct lc_static_load_state *static_load;       /* static_load.c */
+    /* the dense solver's workspace (lcp.c), shared by the dense solves of contact_forces.c, impulse.c and
+     * event_projection.c: scratch that no solve holds past its return */
+    lc_lcp_workspace *lcp;
+    /* regime.c's whole-world touch search (lc_regime_refresh): its pairs and touches */
+    lc_buf b_pairs, b_touch;
+
+    /* shared by the stages of the step in progress */
+    unsigned long edits;          /* bumped by every API call that changes bodies, their states or materials */
+    unsigned long regime_edits;   /* `edits` when rests_dissipative last described the state (regime.c, step.c) */
+    double step_dt;               /* dt of the step in progress (stabilisation time scale) */
     /* dynamic rows the broad phase and the event regime leave out of every pair while the event regime
      * advances the other islands (step.c sets it, broad_phase.c and event_touches.c read it; the broad
      * phase's interface is shared with regime.c and islands.c, which never set it) */
     const uint8_t *excluded;
-
-    /* scratch, reused between steps */
-    lc_lcp_workspace *lcp;
-    lc_buf b_k[4], b_tmp, b_acc;
-    lc_buf b_touch, b_rest, b_pairs, b_aabb, b_island, b_flags, b_mat, b_vec, b_vec2, b_order;
-    lc_buf b_marked_rows;    /* broad_phase.c: the marked rows of lc_broad_phase_of in row order */
-    lc_buf b_have_box, b_bound_boxes; /* broad_phase.c: lc_broad_phase_of's computed boxes, bounds */
-    /* broad_phase.c: the rows in the last sort-and-sweep's x order (sweep_rows of them), the boxes
-     * being sorted, and the counting sort of the pairs */
-    lc_buf b_sweep_order, b_sweep_boxes, b_pair_start, b_pair_tmp;
-    int sweep_rows;
-    lc_buf b_sparse, b_sparse_body, b_sparse_rows; /* sparse_lcp.c: its vectors, the bodies' responses, its rows */
-    double sparse_norm[2];   /* sparse_lcp.c: last ||A|| estimate of normal [0] and tangent [1] rows, */
-    int sparse_norm_rows[2]; /* and its row count: a pile's A changes little from one solve to the next */
-    lc_buf b_group_rows;     /* contact_forces.c: right-hand sides, bounds and forces of a large group */
-    lc_buf b_load, b_load_graph; /* static_load.c: per-body loads, and the graph of who rests on whom */
-    unsigned long edits;     /* bumped by every API call that changes bodies, their states or materials */
-    lc_buf b_fric;           /* impulse.c: friction rows of an impact */
-    lc_buf b_cfric;          /* contact_forces.c: normal and tangent blocks of a friction group */
-    lc_buf b_irows, b_dacc, b_diag;
-    double step_dt;          /* dt of the step in progress (stabilisation time scale) */
 };
 
 /* ---- scratch memory ---- */
@@ -192,6 +189,9 @@ double lc_pair_separation(const lc_world *w, const double *state, int a, int b);
 double lc_vertex_edge_gap(const lc_world *w, const double *state, int a, int vertex, int b, int edge);
 
 /* ---- broad_phase.c ---- */
+typedef struct lc_broad_phase_state lc_broad_phase_state;
+lc_broad_phase_state *lc_broad_phase_state_create(void);
+void lc_broad_phase_state_destroy(lc_broad_phase_state *bp);
 /* Candidate pairs (a < b by row, not both static) whose boxes, swept from s0 to s1 (s1 may equal s0) and
  * grown by margin, overlap. Writes pairs as int[2] into buf; returns count or -1. */
 int lc_broad_phase(lc_world *w, const double *s0, const double *s1, double margin, lc_buf *buf);
@@ -227,6 +227,9 @@ void lc_response_rows(const lc_world *w, const lc_touch *t, int m, int from_tang
 static inline lc_vec2 lc_tangent_of(lc_vec2 n) { return lc_v(-n.y, n.x); }
 
 /* ---- sparse_lcp.c ---- */
+typedef struct lc_sparse_lcp_state lc_sparse_lcp_state;
+lc_sparse_lcp_state *lc_sparse_lcp_state_create(void);
+void lc_sparse_lcp_state_destroy(lc_sparse_lcp_state *sp);
 /* MPRGP on min 1/2 x'Ax + b'x, lo <= x <= hi, with A = J M^-1 J' of the touches' normal (or, with
  * tangent != 0, tangent) rows, never formed. x: start and answer. Returns products of A used (-1: no
  * memory); *violation = largest entry of the projected gradient (units of b). A solve that diverges
@@ -235,6 +238,9 @@ int lc_sparse_lcp(lc_world *w, const lc_touch *t, int m, int tangent, const doub
                   const double *hi, double *x, double tol, int max_products, double *violation);
 
 /* ---- static_load.c ---- */
+typedef struct lc_static_load_state lc_static_load_state;
+lc_static_load_state *lc_static_load_state_create(void);
+void lc_static_load_state_destroy(lc_static_load_state *sl);
 /* Starting guesses for a cold pile's sparse solves (only touches a body rests on get one; f, lam must
  * hold zeros). Each returns 0 (no gravity: no guess), or -1 on allocation failure. */
 /* f[i]: N, the weight each touch carries when loads are shared among a body's supports by the lever rule. */
@@ -247,11 +253,17 @@ int lc_static_load_forces_of(lc_world *w, const lc_touch *t, int m, const int *l
 int lc_static_load_lifts(lc_world *w, const lc_touch *t, int m, const double *deficit, double *lam);
 
 /* ---- contact_forces.c ---- */
+typedef struct lc_contact_forces_state lc_contact_forces_state;
+lc_contact_forces_state *lc_contact_forces_state_create(void);
+void lc_contact_forces_state_destroy(lc_contact_forces_state *cf);
 /* Adds resting contact forces for touches[0..n) into acc (rows indexed), solving the contact LCP.
  * Stores each force in touches[i].value. Returns 0, or -1 on allocation failure. */
 int lc_contact_forces(lc_world *w, const double *state, lc_touch *touches, int n, double *acc);
 
 /* ---- integrator.c ---- */
+typedef struct lc_integrator_state lc_integrator_state;
+lc_integrator_state *lc_integrator_state_create(void);
+void lc_integrator_state_destroy(lc_integrator_state *is);
 /* Advances rows (dynamic bodies) from s0 by h into s1 with the world integrator, touches held as resting
  * contacts; the rows not listed are copied from s0. Returns 0 or -1. */
 int lc_integrate(lc_world *w, const double *s0, double h, const int *rows, int nrows,
@@ -263,6 +275,9 @@ int lc_integrate_rows(lc_world *w, const double *s0, double h, const int *rows, 
                       lc_touch *touches, int ntouches, double *s1);
 
 /* ---- impulse.c ---- */
+typedef struct lc_impulse_state lc_impulse_state;
+lc_impulse_state *lc_impulse_state_create(void);
+void lc_impulse_state_destroy(lc_impulse_state *is);
 /* Resolves the impact among touches[0..n) at the current state (velocities changed in place), with
  * restitution when `elastic`, else perfectly inelastic. Returns the number of points that received an
  * impulse, or -1 on allocation failure. */
