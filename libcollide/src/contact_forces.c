@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "world.h"
+#include "tunables.h"
 
 struct lc_contact_forces_state {
     lc_buf groups, sub;       /* the union-find and the touches in group order; one group's touches */
@@ -68,21 +69,8 @@ static double tangential_velocity(const double *state, const lc_touch *t)
 
 /* The force tolerance of a group: tol while every touch of the group moves slower than 10
  * resting_speed (1 mm/s by default), which is what keeps a resting pile from creeping over minutes;
- * in a group in motion, 1e-4 of its fastest touch's speed per step (v / h), so that a force error
- * moves a point by at most 5e-5 of the distance that touch covers in the step, but never looser
- * than 1e-3 of gravity's acceleration (no loosening at g = 0).
- * Why: in a pile in motion the tight tolerance cost the budget of every solve (MPRGP's normal rows
- * stalled at 1e-6-1e-3 m/s^2 after 1 000 products, the rows between side-by-side boxes the
- * slowest); a 5 kg box dropped into a frictional base-12 pyramid (bench/repro/drop_into_pyramid.py)
- * was undone at the serial cap in step 12, and goes through its first 20 steps in 51 s of CPU with
- * this (34 s without the ceiling, 70 s with a ceiling of 10 contact_gap / h^2).
- * The speed threshold keeps a slow creep (a frictionless pile drifting at 1e-6 m/s) from loosening
- * its own tolerance: at 1 cm/s the pile's slow settling after that impact took 820 s, at 1 mm/s
- * 161 s. The ceiling bounds what a fast body can loosen: a 1e-11 m sliver at 1e6 m/s (dt 1e-3)
- * made the tolerance 1e5 m/s^2 and a step ran to LC_MAX_FORCE_EVALUATIONS_PER_STEP (docs/
- * hardening.md, finding 30); with the ceiling the input takes 0.08 s. */
-#define LC_MOTION_TOLERANCE 1e-4
-#define LC_MOTION_TOLERANCE_CEILING 1e-3
+ * in a group in motion, LC_MOTION_TOLERANCE of its fastest touch's speed per step (v / h), but never
+ * looser than LC_MOTION_TOLERANCE_CEILING of gravity's acceleration (tunables.h says why). */
 static double group_tolerance(const lc_world *w, const double *state, const lc_touch *t, int m, double tol, double h)
 {
     double vmax = 0.0, motion = 10.0 * w->def.resting_speed;
@@ -110,12 +98,6 @@ static void friction_box(const lc_world *w, const double *state, const lc_touch 
     if (slip > v) *hi = 0.0;
     else if (slip < -v) *lo = 0.0;
 }
-
-/* Most alternations between the normal and the friction rows of a small group. */
-#define LC_FRICTION_ROUNDS_SMALL 8
-/* The alternation stops when a round's change grows to this multiple of the previous one's: it is not
- * converging, and more rounds would only cost solves. */
-#define LC_FRICTION_STALL 1.5
 
 /* Tolerance of the next round's solves after round `round` (of `rounds`) changed the forces by
  * `change`: a tenth of that change (inexact block Gauss-Seidel, see solve_with_friction), never below
@@ -234,9 +216,6 @@ static int solve_with_friction(lc_world *w, const double *state, lc_touch *sub, 
     }
     return 0;
 }
-
-/* Most alternations between the normal and the friction rows of a large group. */
-#define LC_FRICTION_ROUNDS 4
 
 /* A large group (more touches than lcp_exact_max) by MPRGP on the sparse response (sparse_lcp.c):
  * the normal rows with the friction forces held, then, with friction, the tangent rows boxed by the

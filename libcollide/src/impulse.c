@@ -12,6 +12,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "world.h"
+#include "tunables.h"
 
 struct lc_impulse_state {
     lc_buf mat, vec, vec2;    /* a dense impact's response matrix, right-hand side and impulses */
@@ -106,9 +107,6 @@ static int solve_block_friction(lc_world *w, double *state, lc_touch *t, int n, 
     }
     return hits;
 }
-
-/* Most alternations between the normal and the friction rows of a large impact. */
-#define LC_IMPULSE_FRICTION_ROUNDS 4
 
 /* The normal rows of a large impact with the friction impulses jt held: jn (warm start and answer)
  * from MPRGP; rhs, lo, hi: scratch of n. Returns products of A used, or -1. */

@@ -12,6 +12,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "world.h"
+#include "tunables.h"
 
 struct lc_sparse_lcp_state {
     lc_buf vectors, body, rows;  /* a solve's vectors, the bodies' responses of a product, its rows */
@@ -37,28 +38,6 @@ void lc_sparse_lcp_state_destroy(lc_sparse_lcp_state *sp)
  * once in J^T x and once in J; the unit of lc_counters.solver_work (a dense pivot visits m per row). */
 #define LC_SPARSE_ROW_ENTRIES 12u
 
-/* Proportioning constant: release bound rows when their chopped gradient outweighs the free one. */
-#define LC_MPRGP_GAMMA 1.0
-/* Power iterations that estimate ||A|| for the expansion step length: from scratch, and when the
- * previous solve had as many rows (the same pile a moment later). Then its estimate is used as it is
- * and refreshed (kept if larger) only before the solve's first expansion step, the one place a low
- * estimate could do harm: a warm-started pile's solve usually takes none, and the refresh was 6 of
- * its 10 products. */
-#define LC_MPRGP_POWER_ITERATIONS 12
-#define LC_MPRGP_POWER_REFRESH 3
-/* A solve whose violation rises to this multiple of the kept iterate's has diverged: it stops and
- * returns the kept iterate (one that came within 2x of the best violation so far).
- * Why: MPRGP lowers the objective at every step, but only in exact arithmetic. A 5e-12 m decagon
- * with a wall corner's touch 3e4 m from its centre (inverse inertia 8.6e21) gave its group
- * ||A|| ~ 1e28 against a smallest scale ~0.1: past round-off, the expansion steps grew the
- * violation to 1e28-1e153 m/s^2 in every solve until the budget, and one step took 142 s to reach
- * the evaluation cap (fuzz finding 31; 0.01 s with this). The violation of a sound solve is not
- * monotone either: in the seven scenes of bench/repro/same_bits.c (790 000 solves) it rose up to
- * 1e5-1e6 times above its best, and a threshold of 1e5 changes the settling scene's state hash;
- * at 1e6, and at 1e8, 100x above that, every hash is the one of the solver without the check. */
-#ifndef LC_MPRGP_DIVERGED   /* -D to measure that margin */
-#define LC_MPRGP_DIVERGED 1e8
-#endif
 
 /* clamps without libm calls (fmin/fmax keep NaN rules and are not inlined): x is finite here */
 static double clamp(double x, double lo, double hi)

@@ -18,6 +18,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "world.h"
+#include "tunables.h"
 
 struct lc_static_load_state {
     lc_buf loads, graph;   /* per-body loads (or lifts), and the graph of who rests on whom */
@@ -33,8 +34,6 @@ void lc_static_load_state_destroy(lc_static_load_state *sl)
     free(sl);
 }
 
-/* cos 60 degrees: steeper touches (walls, the sides of boxes) carry no guessed load */
-#define LC_SUPPORT_COS 0.5
 
 /* The body a touch holds up (its upper body), or -1 when the touch is too steep or that body is static.
  * A touch's force pushes a along n and b along -n. */

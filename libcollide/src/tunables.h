@@ -77,6 +77,9 @@
 /* Most cuts in one island's step; beyond them the rest of the step is taken whole. A rocking block
  * makes a few transitions per step; the cap bounds a pathological chatter. */
 #define LC_CONTACT_MAX_CUTS 8
+/* Most sub-steps a contact-regime island's step is taken in so that no body moves farther than its
+ * own shortest edge in one (regime.h); an island that would need more stays in the event regime. */
+#define LC_CONTACT_MAX_SUBSTEPS 16
 /* A transition within this fraction of the step's end is left to the next step. */
 #define LC_CONTACT_CUT_EPSILON 1e-9
 /* m/s: a point that slips faster than this when a step begins gets friction only against its slip
@@ -139,5 +142,61 @@
 #define LC_CONTACT_PROJECTION_GAIN 1e-2
 #endif
 #define LC_CONTACT_PROJECTION_PRODUCTS 2000
+
+/* ---- contact forces and impulses (contact_forces.c, impulse.c) ---------------------------------- */
+
+/* The force tolerance of a group in motion (contact_forces.c, group_tolerance; a group whose touches
+ * all move slower than 10 resting_speed keeps its tight tolerance, which is what keeps a resting pile
+ * from creeping over minutes): 1e-4 of its fastest touch's speed per step (v / h), so that a force error
+ * moves a point by at most 5e-5 of the distance that touch covers in the step, but never looser
+ * than 1e-3 of gravity's acceleration (no loosening at g = 0).
+ * Why: in a pile in motion the tight tolerance cost the budget of every solve (MPRGP's normal rows
+ * stalled at 1e-6-1e-3 m/s^2 after 1 000 products, the rows between side-by-side boxes the
+ * slowest); a 5 kg box dropped into a frictional base-12 pyramid (bench/repro/drop_into_pyramid.py)
+ * was undone at the serial cap in step 12, and goes through its first 20 steps in 51 s of CPU with
+ * this (34 s without the ceiling, 70 s with a ceiling of 10 contact_gap / h^2).
+ * The speed threshold keeps a slow creep (a frictionless pile drifting at 1e-6 m/s) from loosening
+ * its own tolerance: at 1 cm/s the pile's slow settling after that impact took 820 s, at 1 mm/s
+ * 161 s. The ceiling bounds what a fast body can loosen: a 1e-11 m sliver at 1e6 m/s (dt 1e-3)
+ * made the tolerance 1e5 m/s^2 and a step ran to LC_MAX_FORCE_EVALUATIONS_PER_STEP (docs/
+ * hardening.md, finding 30); with the ceiling the input takes 0.08 s. */
+#define LC_MOTION_TOLERANCE 1e-4
+#define LC_MOTION_TOLERANCE_CEILING 1e-3
+/* Most alternations between the normal and the friction rows of a small group (contact_forces.c). */
+#define LC_FRICTION_ROUNDS_SMALL 8
+/* Most alternations between the normal and the friction rows of a large group (contact_forces.c). */
+#define LC_FRICTION_ROUNDS 4
+/* The alternation stops when a round's change grows to this multiple of the previous one's: it is not
+ * converging, and more rounds would only cost solves. */
+#define LC_FRICTION_STALL 1.5
+/* Most alternations between the normal and the friction rows of a large impact (impulse.c). */
+#define LC_IMPULSE_FRICTION_ROUNDS 4
+
+/* ---- the sparse solver and its starting guesses (sparse_lcp.c, static_load.c) ------------------- */
+
+/* Proportioning constant: release bound rows when their chopped gradient outweighs the free one. */
+#define LC_MPRGP_GAMMA 1.0
+/* Power iterations that estimate ||A|| for the expansion step length: from scratch, and when the
+ * previous solve had as many rows (the same pile a moment later). Then its estimate is used as it is
+ * and refreshed (kept if larger) only before the solve's first expansion step, the one place a low
+ * estimate could do harm: a warm-started pile's solve usually takes none, and the refresh was 6 of
+ * its 10 products. */
+#define LC_MPRGP_POWER_ITERATIONS 12
+#define LC_MPRGP_POWER_REFRESH 3
+/* A solve whose violation rises to this multiple of the kept iterate's has diverged: it stops and
+ * returns the kept iterate (one that came within 2x of the best violation so far).
+ * Why: MPRGP lowers the objective at every step, but only in exact arithmetic. A 5e-12 m decagon
+ * with a wall corner's touch 3e4 m from its centre (inverse inertia 8.6e21) gave its group
+ * ||A|| ~ 1e28 against a smallest scale ~0.1: past round-off, the expansion steps grew the
+ * violation to 1e28-1e153 m/s^2 in every solve until the budget, and one step took 142 s to reach
+ * the evaluation cap (fuzz finding 31; 0.01 s with this). The violation of a sound solve is not
+ * monotone either: in the seven scenes of bench/repro/same_bits.c (790 000 solves) it rose up to
+ * 1e5-1e6 times above its best, and a threshold of 1e5 changes the settling scene's state hash;
+ * at 1e6, and at 1e8, 100x above that, every hash is the one of the solver without the check. */
+#ifndef LC_MPRGP_DIVERGED   /* -D to measure that margin */
+#define LC_MPRGP_DIVERGED 1e8
+#endif
+/* cos 60 degrees: steeper touches (walls, the sides of boxes) carry no guessed load (static_load.c) */
+#define LC_SUPPORT_COS 0.5
 
 #endif
