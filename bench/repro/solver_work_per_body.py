@@ -1,7 +1,7 @@
 """libcollide repro: how much complementarity-solver work a step does per body, on the hardest scenes.
 
 A step is undone with LC_ERR_NUMERIC once its solves have visited more than LC_MAX_SOLVER_WORK_PER_BODY
-(1e9, libcollide/src/step.c) matrix entries per body of the world (lc_counters.solver_work: m^2 per
+(1e9, libcollide/src/tunables.h) matrix entries per body of the world (lc_counters.solver_work: m^2 per
 pivot or sweep of a dense solve of m rows, 12 m per product of a sparse one). This prints, per scene, the step
 with the most solver work per body, its CPU time, and the cap's margin over it: the cap must sit well
 above every legitimate scene, and far below what a pathological step does (fuzz finding 32, four
@@ -28,7 +28,7 @@ import drop_into_pyramid  # noqa: E402  (bench/repro/drop_into_pyramid.py, besid
 import engines  # noqa: E402  (bench/engines/)
 import scenes  # noqa: E402  (bench/scenes.py)
 
-CAP_PER_BODY = 1e9  # LC_MAX_SOLVER_WORK_PER_BODY in libcollide/src/step.c
+CAP_PER_BODY = 1e9  # LC_MAX_SOLVER_WORK_PER_BODY in libcollide/src/tunables.h
 
 
 def world_of(sc: scenes.Scene) -> collide.World:

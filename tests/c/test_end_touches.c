@@ -1,5 +1,5 @@
 /* test_end_touches.c - the touches the end-of-step projection found are reused by the next step's first
- * gather only while nothing has changed (step.c, kept_end_touches). A stale reuse would hand the step
+ * gather only while nothing has changed (event_touches.c, kept_end_touches). A stale reuse would hand the step
  * touches with the old materials or the old bodies; each case below would then fail its physics check.
  * g = 9.81, dt = 1/60 s, a 1 m x 0.5 m, 1 kg box resting on a static floor.
  *  - reuse happens (the event regime's, so that regime is set): in a resting scene each step runs one

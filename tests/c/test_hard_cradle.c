@@ -90,7 +90,7 @@ int main(void)
     /* Touching: each exchange is a simultaneous impact of the whole row, resolved by serial passes
      * into the sequential answer. After the row breaks up, blocks that part slowly after an impact
      * while their rotation turns them back used to be held by contact forces that gained 4.8e-8 J
-     * (3.8e-9 of E0); separating touches now go free (step.c, gather_resting): -1.7e-9 J. */
+     * (3.8e-9 of E0); separating touches now go free (event_touches.c, lc_event_resting): -1.7e-9 J. */
     cradle(0.0, "cradle, touching");
     return CHECK_SUMMARY("test_hard_cradle");
 }

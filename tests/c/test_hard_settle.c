@@ -28,7 +28,7 @@
  *     the energy never above its start by more than m g |v0| dt = 2.2e-3 J, the work of a
  *     weight-sized force on a corner parting at the
  *     block's speed for one step: a touch resting when an interval begins keeps its force while it
- *     parts within that interval (step.c gather_resting, docs/physics.md). */
+ *     parts within that interval (event_touches.c lc_event_resting, docs/physics.md). */
 #include "check.h"
 #include "scenes.h"
 #include "test_hard_common.h"
