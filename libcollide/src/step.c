@@ -1,7 +1,8 @@
 /* The step (lc_world_step): the world is advanced island by island, each island in the regime it needs
- * (docs/contact_regime.md), in tries until every body stayed where its island's build foresaw it. The
- * regimes live in their own files: the event regime (event_regime.c), the contact regime
- * (contact_regime.c); the rule that picks one is regime.c's, the islands are islands.c's. */
+ * (docs/contact_regime.md), in tries until every body stayed where its island's build foresaw it. This
+ * file only orders the stages; each lives in its own file: the islands (islands.c), the rule that picks
+ * an island's regime (regime.c), the event regime (event_regime.c) and the contact regime
+ * (contact_regime.c). A step is taken whole or not at all: every failure undoes it (lc_step_undo). */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -36,6 +37,8 @@ void lc_step_state_destroy(lc_step_state *ss)
     free(ss);
 }
 
+/* The caller sees either the whole step or none of it: no half-advanced world, no contacts of a step
+ * that did not happen. */
 lc_status lc_step_undo(lc_world *w, const lc_step_try *step, lc_status s, const char *what)
 {
     lc_stage_end(w, &w->last.time_step, w->step_t0);
@@ -123,7 +126,8 @@ static lc_status advance_islands(lc_world *w, const lc_step_try *step, double dt
     for (k = 0; k < lc_islands_count(w->islands); ++k) {
         lc_island isl = lc_islands_get(w->islands, k);
         w->last.islands++;
-        if (lc_regime_of(w, &isl, dt) != LC_REGIME_CONTACT || lc_any_marked(step->force_event, isl.rows, isl.nrows)) continue;
+        if (lc_regime_of(w, &isl, dt) != LC_REGIME_CONTACT) continue;
+        if (lc_any_marked(step->force_event, isl.rows, isl.nrows)) continue;   /* an earlier try's verdict */
         st = contact_island(w, step, &isl, k, dt, stuck);
         if (st != LC_OK || *stuck) return st;
         for (i = 0; i < isl.nrows; ++i) excluded[isl.rows[i]] = 1;
@@ -195,8 +199,10 @@ lc_status lc_world_step(lc_world *w, double dt)
     lc_step_state *ss;
     if (w == NULL) return LC_ERR_NULL;
     ss = w->step_state;
+    /* a bad dt is refused before anything changes */
     if (!isfinite(dt)) return lc_fail(w, LC_ERR_NOT_FINITE, "dt is not finite (%g)", dt);
     if (!(dt > 0.0) || dt > 1.0) return lc_fail(w, LC_ERR_OUT_OF_RANGE, "dt = %g is outside (0, 1] s", dt);
+    /* this step's counters and contacts start empty; the stabilisation's time scale is dt */
     memset(&w->last, 0, sizeof w->last);
     w->step_t0 = lc_stage_begin(w);
     w->last.steps = 1;
@@ -217,10 +223,14 @@ lc_status lc_world_step(lc_world *w, double dt)
         w->error[0] = '\0';
         return LC_OK;
     }
+    /* where the step begins: every try restarts from it, every failure goes back to it */
     memcpy(backup, w->state, (size_t)w->count * 6 * sizeof(double));
     step.start = backup;
     step.time0 = time0;
     step.force_event = force_event;
+    /* what each body rests on picks its island's regime: searched again only if an API call changed
+     * the bodies since the last step marked them; the contact regime's kept forces become its warm
+     * start */
     if (lc_regime_refresh(w) != 0 || lc_contact_regime_begin_step(w->contact) != 0)
         return lc_step_undo(w, &step, LC_ERR_NO_MEMORY, "out of memory during the step");
     memcpy(marks0, w->rests_dissipative, (size_t)w->count);
@@ -257,6 +267,7 @@ lc_status lc_world_step(lc_world *w, double dt)
         restart_step(w, backup, marks0, time0);
     }
     w->time = time0 + dt;
+    /* a non-finite state would poison every later step: refuse the step instead */
     for (i = 0; i < w->count * 6; ++i)
         if (!isfinite(w->state[i])) return lc_step_undo(w, &step, LC_ERR_NUMERIC, "the state became non-finite");
     /* the marks describe the end state unless the event regime could not tell (the next step looks) */
