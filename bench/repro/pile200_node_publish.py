@@ -7,10 +7,11 @@ step than stepping. This script builds the same node in this process (`SimNode`,
 markers, 1 kHz clock), calls its `step_once()` --steps times from the drop on (no executor, no
 subscribers, so the publishers only serialize and hand over to DDS), and times with wrappers
 - the physics step (`World.step` as the node calls it) and everything `step_once` does after it,
-- each publisher's `publish()`: bodies/poses, bodies/states, energy, contacts (the rclpy message,
-  converted and serialized inside publish), /tf, markers, /clock,
+- each publisher's `publish()`: bodies/poses, bodies/states, energy (an rclpy message, converted and
+  serialized inside publish), contacts, /tf, markers, /clock (CDR bytes, handed to DDS as they are),
 - `_take_contacts` (the impacts kept since the last state publish and the resting contacts), and
-  the rest of `_publish_state`: building the `Contact` / `Energy` Python messages.
+  the rest of `_publish_state`: building the `Energy` Python message and writing the contacts
+  message's CDR bytes (`cdr.ContactsCdr`; up to commit 04f7bee, one Python `Contact` per contact).
 It prints the totals per step (ms per 1 ms step, the unit of /diagnostics' step_time_mean_ms and
 publish_time_mean_ms) for each --bin of steps and for the whole run, and the contacts per contacts
 message (the impacts since the last message, then the resting contacts; at most 1000) and how many
@@ -39,7 +40,7 @@ sys.path.insert(0, str(ROOT / "tests" / "python"))
 from node_bench import pick_domain, pile_scene  # noqa: E402  (bench/node_bench.py)
 
 PARTS = ("physics step", "after the step", "publish bodies/poses", "publish bodies/states", "publish energy",
-         "publish contacts", "take contacts", "build Contact/Energy msgs", "publish /tf", "publish markers",
+         "publish contacts", "take contacts", "build msgs (Energy, contacts CDR)", "publish /tf", "publish markers",
          "publish /clock")
 
 
@@ -85,7 +86,7 @@ def row(tm: Timers, steps: int) -> dict[str, float]:
     """ms per step of each part; 'build ...' = _publish_state minus what it calls that is timed."""
     inside = ("publish bodies/poses", "publish bodies/states", "publish energy", "publish contacts", "take contacts")
     out = {k: 1e3 * tm.t[k] / steps for k in PARTS if k in tm.t}
-    out["build Contact/Energy msgs"] = 1e3 * (tm.t["_publish_state"] - sum(tm.t[k] for k in inside)) / steps
+    out["build msgs (Energy, contacts CDR)"] = 1e3 * (tm.t["_publish_state"] - sum(tm.t[k] for k in inside)) / steps
     out["after the step"] = 1e3 * (tm.t["step_once"] - tm.t["physics step"]) / steps
     return out
 
@@ -133,7 +134,7 @@ def main() -> int:
         pub = sum(v for p, v in r.items() if p not in ("physics step", "after the step"))
         print(f"\nall {a.steps} steps: physics step {r['physics step']:.3f} ms, after it {r['after the step']:.3f} ms "
               f"per step, of which publishing {pub:.3f} (contacts: take {r['take contacts']:.3f} + build "
-              f"{r['build Contact/Energy msgs']:.3f} + publish {r['publish contacts']:.3f}); "
+              f"{r['build msgs (Energy, contacts CDR)']:.3f} + publish {r['publish contacts']:.3f}); "
               f"{sum(total.contacts) / max(len(total.contacts), 1):.0f} contacts per message, "
               f"{sum(total.impacts) / max(len(total.impacts), 1):.0f} of them impacts")
     finally:

@@ -14,7 +14,7 @@ writer byte for byte against ``rclpy.serialization.serialize_message`` of the sa
 from __future__ import annotations
 
 import struct
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -240,3 +240,133 @@ class TFMessageCdr:
 def clock_cdr(sec: int, nanosec: int) -> bytes:
     """rosgraph_msgs/Clock."""
     return ENCAPSULATION + struct.pack("<iI", sec, nanosec)
+
+
+# ---------------------------------------------------------------- libcollide_msgs/Contacts
+# A Contact element: string body_a, string body_b, then 11 float64 (point x y z, normal x y z, gap,
+# normal_velocity, impulse, tangent_impulse, force) and uint8 kind. Its strings make the elements
+# differ in size, so there is no fixed template: the offsets come from a cumulative sum instead.
+# Each element ends one byte past an 8-aligned offset (the kind after the doubles), so every element
+# after the first starts at 4 mod 8 after 3 bytes of padding; only the first one's start depends on
+# the header (the frame id's length).
+_CONTACT_DOUBLES = 11
+_CONTACT_TAIL = 8 * _CONTACT_DOUBLES + 1   # the doubles and the kind byte
+_CONTACT_GAP = 3                           # padding from one element's kind to the next element
+
+
+def _string_block(s: str) -> bytes:
+    """A CDR string that starts 4-aligned, padded with zeros to a multiple of 4 bytes."""
+    b = s.encode("utf-8")
+    raw = struct.pack("<I", len(b) + 1) + b + b"\x00"
+    return raw + b"\x00" * ((-len(raw)) % 4)
+
+
+def _ragged_index(starts: np.ndarray, lens: np.ndarray) -> np.ndarray:
+    """Concatenation of arange(starts[j], starts[j] + lens[j]) over j, without a Python loop."""
+    total = int(lens.sum())
+    if total == 0:
+        return np.zeros(0, dtype=np.int64)
+    first = np.cumsum(lens) - lens  # where segment j begins in the output
+    return np.repeat(starts - first, lens) + np.arange(total, dtype=np.int64)
+
+
+class _NameTable:
+    """Body id -> its name as a padded CDR string block, looked up for whole id arrays at once.
+
+    An id the table does not know (a body killed after its impact was kept) is named by its number,
+    as str(id)."""
+
+    def __init__(self, names: Mapping[int, str]) -> None:
+        self._names = dict(names)
+        self._build()
+
+    def _build(self) -> None:
+        ids = np.array(sorted(self._names), dtype=np.int64)
+        blocks = [_string_block(self._names[int(i)]) for i in ids]
+        self.ids = ids
+        self.words = np.frombuffer(b"".join(blocks), dtype="<u4") if blocks else np.zeros(0, dtype="<u4")
+        lens = np.array([len(b) for b in blocks], dtype=np.int64)
+        self.lens = lens  # bytes, multiples of 4
+        self.word_starts = (np.cumsum(lens) - lens) // 4
+
+    def rows(self, ids: np.ndarray) -> np.ndarray:
+        """Row in the table of each id (unknown ids are added first)."""
+        ids = ids.astype(np.int64)
+        pos = np.searchsorted(self.ids, ids)
+        known = self.ids[np.minimum(pos, len(self.ids) - 1)] == ids if len(self.ids) else np.zeros(len(ids), bool)
+        if not known.all():
+            for i in np.unique(ids[~known]):
+                self._names[int(i)] = str(int(i))
+            self._build()
+            return self.rows(ids)
+        return pos
+
+
+class ContactsCdr:
+    """libcollide_msgs/Contacts from rows of collide.CONTACT_DTYPE (lc_contact), written by numpy.
+
+    The same message as one ``Contact`` per row with body_a/body_b = the bodies' names (their id as
+    text if unknown), point/normal (x, y, 0), the five doubles copied bit for bit and kind = the
+    row's kind; the ``time`` of lc_contact is not part of the message."""
+
+    def __init__(self, frame_id: str, names: Mapping[int, str]) -> None:
+        w = CdrWriter()
+        self._sec = w.header(0, 0, frame_id) - _HDR
+        self._count = w.u32(0) - _HDR
+        self._head = np.frombuffer(bytes(w.buf), dtype=np.uint8)
+        self._first = len(w.buf) - _HDR  # data offset of the first element (4-aligned)
+        self._names = _NameTable(names)
+
+    def _layout(self, la: np.ndarray, lb: np.ndarray) -> tuple[np.ndarray, np.ndarray, int]:
+        """Data offsets of each element and of its doubles, and the message's data size."""
+        names = la + lb
+        pad = (-(4 + names)) % 8           # to 8-align the doubles of an element starting at 4 mod 8
+        pad[0] = (-(self._first + names[0])) % 8
+        size = names + pad + _CONTACT_TAIL + _CONTACT_GAP
+        starts = self._first + np.cumsum(size) - size
+        doubles = starts + names + pad
+        return starts, doubles, int(doubles[-1]) + _CONTACT_TAIL
+
+    @staticmethod
+    def _doubles(c: np.ndarray) -> np.ndarray:
+        """(n, 11) float64 of each Contact after its strings."""
+        out = np.zeros((len(c), _CONTACT_DOUBLES))
+        out[:, 0:2] = c["point"]
+        out[:, 3:5] = c["normal"]
+        out[:, 6] = c["gap"]
+        out[:, 7] = c["normal_velocity"]
+        out[:, 8] = c["impulse"]
+        out[:, 9] = c["tangent_impulse"]
+        out[:, 10] = c["force"]
+        return out
+
+    def _write_names(self, u32: np.ndarray, starts: np.ndarray, ra: np.ndarray, rb: np.ndarray) -> None:
+        """Each element's two string blocks, which lie back to back from its start (4-byte words)."""
+        t = self._names
+        src_starts = np.column_stack([t.word_starts[ra], t.word_starts[rb]]).ravel()
+        src_lens = np.column_stack([t.lens[ra], t.lens[rb]]).ravel() // 4
+        dst = _ragged_index(starts // 4, (t.lens[ra] + t.lens[rb]) // 4)
+        u32[dst] = t.words[_ragged_index(src_starts, src_lens)]
+
+    def encode(self, sec: int, nanosec: int, contacts: np.ndarray) -> bytes:
+        """The serialized message (encapsulation header included) for ``contacts`` in their order."""
+        n = len(contacts)
+        size, starts, doubles = self._first, np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
+        if n:
+            # one lookup for both columns: a lookup that adds an unknown id renumbers the rows
+            ra, rb = np.split(self._names.rows(np.concatenate([contacts["body_a"], contacts["body_b"]])), 2)
+            starts, doubles, size = self._layout(self._names.lens[ra], self._names.lens[rb])
+        # The raw buffer starts 4 bytes early so that data offset 0 (after the header) is 8-aligned.
+        raw = np.zeros(8 + size + 8, dtype=np.uint8)
+        buf = raw[4:8 + size]
+        buf[:len(self._head)] = self._head
+        u32 = raw[8:8 + size // 4 * 4].view("<u4")
+        u32[self._sec // 4] = np.uint32(sec)
+        u32[self._sec // 4 + 1] = np.uint32(nanosec)
+        u32[self._count // 4] = np.uint32(n)
+        if n:
+            self._write_names(u32, starts, ra, rb)
+            f64 = raw[8:8 + size // 8 * 8].view("<f8")
+            f64[(doubles // 8)[:, None] + np.arange(_CONTACT_DOUBLES)] = self._doubles(contacts)
+            buf[_HDR + doubles + 8 * _CONTACT_DOUBLES] = contacts["kind"].astype(np.uint8)
+        return buf.tobytes()

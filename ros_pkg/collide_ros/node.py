@@ -5,7 +5,7 @@
 Physics runs in C. This module is a thin shell: a sleep-until loop steps the world at
 ``time_step`` / ``real_time_factor`` of wall time and publishes at rates counted in sim-time steps;
 an executor thread handles commands, services and parameters as they arrive, under one lock. Bulk messages
-(poses, states, /tf, markers, /clock) are written as CDR bytes with numpy (cdr.py, markers.py).
+(poses, states, contacts, /tf, markers, /clock) are written as CDR bytes with numpy (cdr.py, markers.py).
 Bad input is rejected with a throttled warning naming the reason; nothing a peer sends stops the loop.
 """
 from __future__ import annotations
@@ -24,8 +24,7 @@ import rclpy
 from builtin_interfaces.msg import Time
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from geometry_msgs.msg import PoseArray, Twist, TwistStamped, Vector3, WrenchStamped
-from geometry_msgs.msg import Point as PointMsg
-from libcollide_msgs.msg import BodyStates, Contact, Contacts, Energy, SpringCommand, ThrusterCommand
+from libcollide_msgs.msg import BodyStates, Contacts, Energy, SpringCommand, ThrusterCommand
 from libcollide_msgs.srv import Kill, Spawn, Step
 from rcl_interfaces.msg import SetParametersResult
 from rclpy.exceptions import InvalidParameterTypeException, InvalidParameterValueException
@@ -152,6 +151,17 @@ def _polygons_overlap(a: np.ndarray, b: np.ndarray) -> bool:
         if np.any((pa.max(axis=0) <= pb.min(axis=0) + 1e-12) | (pb.max(axis=0) <= pa.min(axis=0) + 1e-12)):
             return False  # a separating axis exists
     return True
+
+
+def _concat_rows(parts: list[np.ndarray]) -> np.ndarray:
+    """np.concatenate of structured rows, copied as opaque records when all have one dtype: numpy
+    copies a structured dtype with padding (lc_contact's) field by field into a packed dtype, several
+    times slower; this keeps the dtype."""
+    dtype = parts[0].dtype
+    if any(p.dtype != dtype for p in parts):
+        return np.concatenate(parts)
+    record = np.dtype((np.void, dtype.itemsize))
+    return np.concatenate([p.view(record) for p in parts]).view(dtype)
 
 
 class SimNode(Node):
@@ -355,6 +365,7 @@ class SimNode(Node):
         self._cdr_poses = cdr.PoseArrayCdr(len(self._dyn_rows), frame)
         self._cdr_states = cdr.BodyStatesCdr(self._dyn_names, frame)
         self._cdr_tf = cdr.TFMessageCdr(frame, self._dyn_names)
+        self._cdr_contacts = cdr.ContactsCdr(frame, self._name_of_id)
         outlines, colors = [], []
         for i, n in enumerate(self._names):
             outlines.append(self._bodies[n].local_vertices())
@@ -956,23 +967,7 @@ class SimNode(Node):
         em.linear_momentum = Vector3(x=float(e.linear_momentum[0]), y=float(e.linear_momentum[1]), z=0.0)
         em.angular_momentum = float(e.angular_momentum)
         self._pub_energy.publish(em)
-        cm = Contacts()
-        cm.header.stamp = stamp
-        cm.header.frame_id = frame
-        c = self._take_contacts()
-        if len(c):
-            out = []
-            for row in c:
-                out.append(Contact(
-                    body_a=self._name_of_id.get(int(row["body_a"]), str(int(row["body_a"]))),
-                    body_b=self._name_of_id.get(int(row["body_b"]), str(int(row["body_b"]))),
-                    point=PointMsg(x=float(row["point"][0]), y=float(row["point"][1]), z=0.0),
-                    normal=Vector3(x=float(row["normal"][0]), y=float(row["normal"][1]), z=0.0),
-                    gap=float(row["gap"]), normal_velocity=float(row["normal_velocity"]),
-                    impulse=float(row["impulse"]), tangent_impulse=float(row["tangent_impulse"]),
-                    force=float(row["force"]), kind=int(row["kind"])))
-            cm.contacts = out
-        self._pub_contacts.publish(cm)
+        self._pub_contacts.publish(self._cdr_contacts.encode(sec, ns, self._take_contacts()))
 
     def _collect_collisions(self) -> None:
         """Keep the impacts of every step until the next contacts publish (they last one step)."""
@@ -999,7 +994,7 @@ class SimNode(Node):
         parts = [*self._pending, resting]
         self._pending = []
         self._pending_count = 0
-        return np.concatenate(parts) if len(parts) > 1 else resting.copy()
+        return _concat_rows(parts) if len(parts) > 1 else resting.copy()
 
     def _publish_tf(self) -> None:
         sec, ns = self._stamp()

@@ -10,13 +10,14 @@ import numpy as np
 import pytest
 from builtin_interfaces.msg import Time
 from geometry_msgs.msg import Point, Pose, PoseArray, Quaternion, TransformStamped, Twist, Vector3
-from libcollide_msgs.msg import BodyStates
+from libcollide_msgs.msg import BodyStates, Contact, Contacts
 from rclpy.serialization import deserialize_message, serialize_message
 from rosgraph_msgs.msg import Clock
 from std_msgs.msg import ColorRGBA
 from tf2_msgs.msg import TFMessage
 from visualization_msgs.msg import Marker, MarkerArray
 
+import collide
 from collide_ros import cdr, markers
 
 RNG = np.random.default_rng(7)
@@ -144,3 +145,46 @@ def test_delete_all() -> None:
     msg = deserialize_message(markers.delete_all("world", 1, 2), MarkerArray)
     assert len(msg.markers) == 1 and msg.markers[0].action == Marker.DELETEALL
     assert msg.markers[0].header.frame_id == "world"
+
+
+def contact_msg(row: np.ndarray, names: dict[int, str]) -> Contact:
+    """The node's former object path for one contact (its name lookup included)."""
+    return Contact(
+        body_a=names.get(int(row["body_a"]), str(int(row["body_a"]))),
+        body_b=names.get(int(row["body_b"]), str(int(row["body_b"]))),
+        point=Point(x=float(row["point"][0]), y=float(row["point"][1]), z=0.0),
+        normal=Vector3(x=float(row["normal"][0]), y=float(row["normal"][1]), z=0.0),
+        gap=float(row["gap"]), normal_velocity=float(row["normal_velocity"]),
+        impulse=float(row["impulse"]), tangent_impulse=float(row["tangent_impulse"]),
+        force=float(row["force"]), kind=int(row["kind"]))
+
+
+def random_contacts(n: int, ids: int) -> np.ndarray:
+    c = np.zeros(n, dtype=collide.CONTACT_DTYPE)
+    c["body_a"], c["body_b"] = RNG.integers(0, ids, n), RNG.integers(0, ids, n)
+    c["point"], c["normal"] = RNG.normal(size=(n, 2)), RNG.normal(size=(n, 2))
+    for f in ("gap", "normal_velocity", "impulse", "tangent_impulse", "force", "time"):
+        c[f] = RNG.normal(size=n)
+    c["kind"] = RNG.integers(0, 2, n)
+    return c
+
+
+# frame ids of every length mod 8 (they decide the first contact's alignment); names of every
+# length mod 4, a UTF-8 one, and ids 40-44 unknown (named by their number, as the node does for a
+# body killed after its impact was kept)
+@pytest.mark.parametrize("frame", ["", "w", "wo", "map", "worl", "world", "world_", "world_2", "world_frame"])
+@pytest.mark.parametrize("n", [0, 1, 2, 3, 1000])
+def test_contacts(frame: str, n: int) -> None:
+    names = {i: "b" * (i % 9) + str(i) for i in range(40)}
+    names[7] = "bloc\u00e97"
+    rows = random_contacts(n, 45)
+    w = cdr.ContactsCdr(frame, names)
+    msg = Contacts()
+    msg.header.stamp = Time(sec=3, nanosec=999_999_999)
+    msg.header.frame_id = frame
+    msg.contacts = [contact_msg(r, names) for r in rows]
+    check(w.encode(3, 999_999_999, rows), msg)
+    # the encoder is reused (and now knows the unknown ids): another message with other rows
+    rows2 = random_contacts(n, 45)
+    msg.contacts = [contact_msg(r, names) for r in rows2]
+    check(w.encode(3, 999_999_999, rows2), msg)
