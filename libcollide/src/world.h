@@ -115,10 +115,12 @@ struct lc_world {
     /* regime.c's whole-world touch search (lc_regime_refresh): its pairs and touches */
     lc_buf b_pairs, b_touch;
 
-    /* shared by the stages of the step in progress */
-    unsigned long edits;          /* bumped by every API call that changes bodies, their states or materials */
+    /* read by several files */
+    unsigned long edits;          /* bumped by every API call that changes bodies, their states or materials:
+                                     a search kept from the last step holds only while it is unchanged */
     unsigned long regime_edits;   /* `edits` when rests_dissipative last described the state (regime.c, step.c) */
-    double step_dt;               /* dt of the step in progress (stabilisation time scale) */
+    double step_dt;               /* dt of the step in progress (the stabilisation's time scale: integrator.c,
+                                     contact_forces.c) */
     /* dynamic rows the broad phase and the event regime leave out of every pair while the event regime
      * advances the other islands (step.c sets it, broad_phase.c and event_touches.c read it; the broad
      * phase's interface is shared with regime.c and islands.c, which never set it) */
