@@ -102,7 +102,7 @@ int lc_kept_touches_store(lc_kept_touches *k, const lc_world *w, const lc_island
     rec->state_at = x->nstates;
     rec->int_at = x->nints;
     tt += x->ntouches;
-    memcpy(tt, t, (size_t)n * sizeof(lc_touch));
+    if (n > 0) memcpy(tt, t, (size_t)n * sizeof(lc_touch));
     for (i = 0; i < n; ++i) {
         /* the next step's start: velocities as the step left them (the energy guard may have scaled
          * them after the search), no force or impulse yet */
@@ -113,9 +113,11 @@ int lc_kept_touches_store(lc_kept_touches *k, const lc_world *w, const lc_island
         tt[i].value = tt[i].tangent = tt[i].vn_pre = tt[i].target_vn = 0.0;
     }
     for (i = 0; i < isl->nrows; ++i) memcpy(&st[x->nstates + (size_t)i * 6], &w->state[isl->rows[i] * 6], 6 * sizeof(double));
-    memcpy(&st[x->nstates + (size_t)isl->nrows * 6], margin, (size_t)isl->npairs * sizeof(double));
     memcpy(&in[x->nints], isl->rows, (size_t)isl->nrows * sizeof(int));
-    memcpy(&in[x->nints + (size_t)isl->nrows], isl->pairs, 2 * (size_t)isl->npairs * sizeof(int));
+    if (isl->npairs > 0) {
+        memcpy(&st[x->nstates + (size_t)isl->nrows * 6], margin, (size_t)isl->npairs * sizeof(double));
+        memcpy(&in[x->nints + (size_t)isl->nrows], isl->pairs, 2 * (size_t)isl->npairs * sizeof(int));
+    }
     x->nrecords++;
     x->ntouches += (size_t)n;
     x->nstates += (size_t)isl->nrows * 6 + (size_t)isl->npairs;
@@ -140,7 +142,7 @@ int lc_kept_touches_take(const lc_kept_touches *k, const lc_world *w, const lc_i
     if (rec->nrows != isl->nrows || rec->npairs != isl->npairs || rec->dt != dt || rec->edits != w->edits) return -2;
     in = (const int *)x->ints.p + rec->int_at;
     if (memcmp(in, isl->rows, (size_t)isl->nrows * sizeof(int)) != 0 ||
-        memcmp(in + isl->nrows, isl->pairs, 2 * (size_t)isl->npairs * sizeof(int)) != 0)
+        (isl->npairs > 0 && memcmp(in + isl->nrows, isl->pairs, 2 * (size_t)isl->npairs * sizeof(int)) != 0))
         return -2;
     st = (const double *)x->states.p + rec->state_at;
     for (i = 0; i < isl->nrows; ++i)
