@@ -3,9 +3,8 @@
 #include <math.h>
 #include <string.h>
 #include "contact_exact.h"
+#include "tunables.h"
 
-/* Pivots allowed per unknown before the pivoting is given up (it cycles only on degenerate ties). */
-#define LC_LEMKE_PIVOTS_PER_UNKNOWN 20
 
 size_t lc_contact_exact_scratch(int nrows)
 {

@@ -20,6 +20,8 @@ struct lc_islands {
     lc_buf b_pair_start;  /* count + 1 */
     lc_buf b_boxes;       /* swept boxes, 4 per row */
     lc_buf b_set;         /* hash set of the pairs */
+    lc_buf b_reach_boxes; /* lc_islands_unforeseen: the actual paths' boxes, and their pairs */
+    lc_buf b_reach_pairs;
     int set_size;
 };
 
@@ -40,6 +42,8 @@ void lc_islands_destroy(lc_islands *is)
     lc_buf_free(&is->b_pair_start);
     lc_buf_free(&is->b_boxes);
     lc_buf_free(&is->b_set);
+    lc_buf_free(&is->b_reach_boxes);
+    lc_buf_free(&is->b_reach_pairs);
     free(is);
 }
 
@@ -214,3 +218,44 @@ lc_island lc_islands_get(const lc_islands *is, int k)
 }
 
 int lc_islands_of(const lc_islands *is, int row) { return ((const int *)is->b_of.p)[row]; }
+
+int lc_islands_unforeseen(lc_world *w, lc_islands *is, const double *start, double *reach)
+{
+    int n = w->count, i, np, found = 0, outside = 0;
+    double *boxes = lc_buf_get(&is->b_reach_boxes, (size_t)n * 4 * sizeof(double));
+    const double *built = (const double *)is->b_boxes.p;
+    const int *pairs;
+    if (boxes == NULL) return -1;
+    for (i = 0; i < n; ++i) {
+        double turn = fabs(w->state[i * 6 + SA] - start[i * 6 + SA]);
+        double bulge = w->shape[i].radius * (turn < 3.0 ? turn * turn / 8.0 : 1.0);
+        const double *b = &boxes[4 * i], *p = &built[4 * i];
+        lc_swept_box(w, start, w->state, i, w->def.contact_distance + bulge, &boxes[4 * i]);
+        if (b[0] < p[0] || b[1] < p[1] || b[2] > p[2] || b[3] > p[3]) outside = 1;
+    }
+    /* every path inside the box its island was built with: the build's pairs hold every meeting */
+    if (!outside) return 0;
+    np = lc_broad_phase_boxes(w, boxes, &is->b_reach_pairs);
+    if (np < 0) return -1;
+    pairs = (const int *)is->b_reach_pairs.p;
+    for (i = 0; i < np; ++i) {
+        int a = pairs[2 * i], b = pairs[2 * i + 1], q;
+        if (lc_islands_has_pair(is, a, b)) continue;
+        found++;
+        for (q = 0; q < 2; ++q) {
+            int r = q ? b : a;
+            double *x = &reach[4 * r];
+            const double *y = &boxes[4 * r];
+            if (w->is_static[r]) continue;
+            if (x[0] > x[2]) {
+                memcpy(x, y, 4 * sizeof(double));
+            } else {
+                x[0] = fmin(x[0], y[0]);
+                x[1] = fmin(x[1], y[1]);
+                x[2] = fmax(x[2], y[2]);
+                x[3] = fmax(x[3], y[3]);
+            }
+        }
+    }
+    return found;
+}

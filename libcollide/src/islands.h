@@ -41,5 +41,11 @@ int lc_islands_count(const lc_islands *is);
 lc_island lc_islands_get(const lc_islands *is, int k);
 /* The island of a row in the last build, -1 for a static body. */
 int lc_islands_of(const lc_islands *is, int row);
+/* After a step from state `start`: the bodies that went where the last build did not foresee. The boxes
+ * their actual paths swept (start and end poses, the bulge of their turn, contact_distance) overlap
+ * another body's where the build had no pair, so a contact between them could have been missed. Their
+ * swept boxes are added to `reach` (4 doubles per row, as lc_islands_build takes it) for the next try.
+ * Returns how many pairs that was, or -1 without memory. */
+int lc_islands_unforeseen(struct lc_world *w, lc_islands *is, const double *start, double *reach);
 
 #endif

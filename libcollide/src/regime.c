@@ -1,18 +1,23 @@
 /* The regime rule (regime.h). */
 #include <math.h>
 #include "regime.h"
+#include "tunables.h"
 
-int lc_regime_too_fast(const lc_world *w, const lc_island *isl, double dt)
+int lc_regime_substeps(const lc_world *w, const lc_island *isl, double dt)
 {
+    double worst = 0.0;
     int i;
     for (i = 0; i < isl->nrows; ++i) {
         int r = isl->rows[i];
         const double *s = &w->state[r * 6];
         double reach = (sqrt(s[SVX] * s[SVX] + s[SVY] * s[SVY]) + fabs(s[SW]) * w->shape[r].radius) * dt;
-        if (!(reach <= w->shape[r].min_edge)) return 1;
+        if (!(reach <= LC_CONTACT_MAX_SUBSTEPS * w->shape[r].min_edge)) return 0;
+        worst = fmax(worst, reach / w->shape[r].min_edge);
     }
-    return 0;
+    return worst <= 1.0 ? 1 : (int)ceil(worst);
 }
+
+int lc_regime_too_fast(const lc_world *w, const lc_island *isl, double dt) { return lc_regime_substeps(w, isl, dt) == 0; }
 
 lc_regime lc_regime_of(const lc_world *w, const lc_island *isl, double dt)
 {

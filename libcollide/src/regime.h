@@ -6,8 +6,10 @@
  * impacts of bodies in flight are exact there and cheap; e = 1 chains (the cradle) need the sequential
  * impacts only the event regime gives; a body resting on a dissipative touch is where impacts turn
  * into an unending stream of micro-impacts (inelastic collapse) and the contact regime takes over.
- * An island with a body that moves farther than its own size in a step stays in the event regime
- * (lc_regime_too_fast). LC_REGIME_EVENT and LC_REGIME_CONTACT put every island in that regime. */
+ * An island with a body that moves farther than its own size in a step is taken in sub-steps
+ * (lc_regime_substeps), and stays in the event regime only when it would need more than
+ * LC_CONTACT_MAX_SUBSTEPS: one fast box falling into a pile of hundreds must not put the pile in the
+ * event regime, whose every impact there re-integrates the pile. LC_REGIME_EVENT and LC_REGIME_CONTACT put every island in that regime. */
 #ifndef LC_REGIME_H
 #define LC_REGIME_H
 
@@ -16,9 +18,13 @@
 
 /* The regime of an island for a step of dt. */
 lc_regime lc_regime_of(const lc_world *w, const lc_island *isl, double dt);
-/* 1 if a body of the island moves farther than its own shortest edge in dt (its centre, or its
- * farthest vertex by turning): the contact regime sees each contact at the step's start geometry and
- * cannot follow a body through several bounces in one step; the event regime finds each impact. */
+/* The sub-steps the contact regime takes a step of dt of the island in: enough that no body moves
+ * farther than its own shortest edge in one (its centre, or its farthest vertex by turning), since the
+ * contact regime sees each contact at its (sub-)step's start geometry and cannot follow a body through
+ * several bounces in one; 0 when more than LC_CONTACT_MAX_SUBSTEPS would be needed (the event regime
+ * then finds each impact). */
+int lc_regime_substeps(const lc_world *w, const lc_island *isl, double dt);
+/* lc_regime_substeps(w, isl, dt) == 0. */
 int lc_regime_too_fast(const lc_world *w, const lc_island *isl, double dt);
 /* Marks the bodies of touches t[0..n) between a pair with e < 1 (w->rests_dissipative). */
 void lc_regime_mark(lc_world *w, const lc_touch *t, int n);

@@ -11,13 +11,13 @@
 #include "event_regime.h"
 #include "islands.h"
 #include "regime.h"
+#include "sleep.h"
 #include "tunables.h"
 
 struct lc_step_state {
     lc_buf start, marks0;         /* the state and w->rests_dissipative the step began with */
     lc_buf force_event;           /* rows an earlier try sends to the event regime (lc_step_try) */
-    lc_buf reach, reach_boxes;    /* where the tries' bodies went; a try's swept boxes */
-    lc_buf pairs;                 /* the pairs of those boxes */
+    lc_buf reach;                 /* where the tries' bodies went */
     lc_buf event_rows, excluded;  /* a try's event rows, and its contact islands' rows (w->excluded) */
 };
 
@@ -30,8 +30,6 @@ void lc_step_state_destroy(lc_step_state *ss)
     lc_buf_free(&ss->marks0);
     lc_buf_free(&ss->force_event);
     lc_buf_free(&ss->reach);
-    lc_buf_free(&ss->reach_boxes);
-    lc_buf_free(&ss->pairs);
     lc_buf_free(&ss->event_rows);
     lc_buf_free(&ss->excluded);
     free(ss);
@@ -48,58 +46,31 @@ lc_status lc_step_undo(lc_world *w, const lc_step_try *step, lc_status s, const 
     return lc_fail(w, s, "%s; the step was undone", what);
 }
 
-/* The bodies that went where their island's build did not foresee: the boxes their actual paths swept
- * (start and end poses, the bulge of their turn, contact_distance) overlap another body's where the
- * build had no pair, so a contact between them could have been missed. Their swept boxes are added to
- * `reach` for the next try. Returns how many pairs that was, or -1 without memory. */
-static int unforeseen_pairs(lc_world *w, lc_step_state *ss, const double *backup, double *reach)
+/* The resting contacts reported since contact index `first` go (a sub-step's, which the next one
+ * reports anew); its collisions stay. */
+static void drop_resting(lc_world *w, int first)
 {
-    int n = w->count, i, np, found = 0, outside = 0;
-    double *boxes = lc_buf_get(&ss->reach_boxes, (size_t)n * 4 * sizeof(double));
-    const double *built = lc_islands_boxes(w->islands);
-    const int *pairs;
-    if (boxes == NULL) return -1;
-    for (i = 0; i < n; ++i) {
-        double turn = fabs(w->state[i * 6 + SA] - backup[i * 6 + SA]);
-        double bulge = w->shape[i].radius * (turn < 3.0 ? turn * turn / 8.0 : 1.0);
-        const double *b = &boxes[4 * i], *p = &built[4 * i];
-        lc_swept_box(w, backup, w->state, i, w->def.contact_distance + bulge, &boxes[4 * i]);
-        if (b[0] < p[0] || b[1] < p[1] || b[2] > p[2] || b[3] > p[3]) outside = 1;
-    }
-    /* every path inside the box its island was built with: the build's pairs hold every meeting */
-    if (!outside) return 0;
-    np = lc_broad_phase_boxes(w, boxes, &ss->pairs);
-    if (np < 0) return -1;
-    pairs = (const int *)ss->pairs.p;
-    for (i = 0; i < np; ++i) {
-        int a = pairs[2 * i], b = pairs[2 * i + 1], q;
-        if (lc_islands_has_pair(w->islands, a, b)) continue;
-        found++;
-        for (q = 0; q < 2; ++q) {
-            int r = q ? b : a;
-            double *x = &reach[4 * r];
-            const double *y = &boxes[4 * r];
-            if (w->is_static[r]) continue;
-            if (x[0] > x[2]) {
-                memcpy(x, y, 4 * sizeof(double));
-            } else {
-                x[0] = fmin(x[0], y[0]);
-                x[1] = fmin(x[1], y[1]);
-                x[2] = fmax(x[2], y[2]);
-                x[3] = fmax(x[3], y[3]);
-            }
-        }
-    }
-    return found;
+    int i, n = first;
+    for (i = first; i < w->contact_count; ++i)
+        if (w->contacts[i].kind != LC_CONTACT_RESTING) w->contacts[n++] = w->contacts[i];
+        else w->last.resting_contacts--;
+    w->contact_count = n;
 }
 
-/* The contact advance of island isl over dt: LC_OK, or the step has failed (and is undone). *stuck is
- * set to the island's index + 1 when its projection could not separate its bodies. */
+/* The contact advance of island isl over dt, in as many sub-steps as its fastest body needs
+ * (lc_regime_substeps): LC_OK, or the step has failed (and is undone). *stuck is set to the island's
+ * index + 1 when a sub-step ended with an overlap or an energy gain it could not resolve. */
 static lc_status contact_island(lc_world *w, const lc_step_try *step, const lc_island *isl, int index, double dt,
                                 int *stuck)
 {
     double ts = lc_stage_begin(w);
-    int r = lc_contact_advance(w, w->contact, isl, dt);
+    int k, r = 0, n = lc_regime_substeps(w, isl, dt);
+    if (n < 1) n = LC_CONTACT_MAX_SUBSTEPS;   /* LC_REGIME_CONTACT forces it on an island faster than that */
+    for (k = 0; k < n && r == 0; ++k) {
+        int first = w->contact_count;
+        r = lc_contact_advance(w, w->contact, isl, dt / n);
+        if (r == 0 && k + 1 < n) drop_resting(w, first);
+    }
     lc_stage_end(w, &w->last.time_contact_regime, ts);
     if (r == -1) return lc_step_undo(w, step, LC_ERR_NO_MEMORY, "out of memory during the step");
     if (r == -2)
@@ -109,29 +80,52 @@ static lc_status contact_island(lc_world *w, const lc_step_try *step, const lc_i
     return LC_OK;
 }
 
+/* 1 if no island of this step can be in the contact regime or asleep: every body perfectly elastic (no
+ * pair dissipates, so none comes to rest), sleep off, the regime not forced to CONTACT. Such a world is
+ * advanced by one event pass without the island build, as islands would all be the event regime's
+ * (a thousand blocks flying at e = 1: the build doubled the step). */
+static int all_events(const lc_world *w)
+{
+    int i;
+    if (w->def.regime == LC_REGIME_CONTACT || w->def.allow_sleep) return 0;
+    for (i = 0; i < w->count; ++i)
+        if (w->elasticity[i] < 1.0) return 0;
+    return 1;
+}
+
 /* One try at the step: the islands of the current state (their swept boxes grown to `reach`), each
- * advanced in its regime. LC_OK, or the step has failed (and is undone). A try stops early, with
- * *stuck the island's index + 1, when a contact island ends overlapping. */
+ * advanced in its regime, or asleep. LC_OK, or the step has failed (and is undone). A try stops early,
+ * with *stuck the island's index + 1, when a contact island ends overlapping. *built: 1 if the islands
+ * were built (0: one event pass over the world, all_events). */
 static lc_status advance_islands(lc_world *w, const lc_step_try *step, double dt, const double *reach,
-                                 int *marks_known, int *stuck)
+                                 int *marks_known, int *stuck, int *built)
 {
     int *event_rows = lc_buf_get(&w->step_state->event_rows, (size_t)w->count * sizeof(int));
     uint8_t *excluded = lc_buf_get(&w->step_state->excluded, (size_t)w->count);
-    int n_event = 0, k, i, any_contact = 0;
+    int n_event = 0, k, i, any_excluded = 0;
     double t0 = step->time0;
     lc_status st;
-    if (!event_rows || !excluded || lc_islands_build(w, w->islands, dt, NULL, reach) != 0)
-        return lc_step_undo(w, step, LC_ERR_NO_MEMORY, "out of memory during the step");
+    if (!event_rows || !excluded) return lc_step_undo(w, step, LC_ERR_NO_MEMORY, "out of memory during the step");
     memset(excluded, 0, (size_t)w->count);
-    for (k = 0; k < lc_islands_count(w->islands); ++k) {
-        lc_island isl = lc_islands_get(w->islands, k);
+    *built = !all_events(w);
+    if (*built) {
+        if (lc_islands_build(w, w->islands, dt, lc_sleep_asleep(w->sleep), reach) != 0)
+            return lc_step_undo(w, step, LC_ERR_NO_MEMORY, "out of memory during the step");
+        for (k = 0; k < lc_islands_count(w->islands); ++k) {
+            lc_island isl = lc_islands_get(w->islands, k);
+            int sleeps = lc_sleep_island(w->sleep, w, &isl);
+            if (!sleeps) w->last.islands++;
+            if (!sleeps && lc_regime_of(w, &isl, dt) != LC_REGIME_CONTACT) continue;
+            if (!sleeps && lc_any_marked(step->force_event, isl.rows, isl.nrows)) continue;   /* an earlier try's verdict */
+            if (!sleeps) {
+                st = contact_island(w, step, &isl, k, dt, stuck);
+                if (st != LC_OK || *stuck) return st;
+            }
+            for (i = 0; i < isl.nrows; ++i) excluded[isl.rows[i]] = 1;
+            any_excluded = 1;
+        }
+    } else {
         w->last.islands++;
-        if (lc_regime_of(w, &isl, dt) != LC_REGIME_CONTACT) continue;
-        if (lc_any_marked(step->force_event, isl.rows, isl.nrows)) continue;   /* an earlier try's verdict */
-        st = contact_island(w, step, &isl, k, dt, stuck);
-        if (st != LC_OK || *stuck) return st;
-        for (i = 0; i < isl.nrows; ++i) excluded[isl.rows[i]] = 1;
-        any_contact = 1;
     }
     /* the event islands' rows together, in row order; an island whose touch comes to rest is handed to
      * the contact regime at that instant, and the others go on from there */
@@ -142,14 +136,15 @@ static lc_status advance_islands(lc_world *w, const lc_step_try *step, double dt
         for (i = 0; i < w->count; ++i)
             if (!w->is_static[i] && !excluded[i]) event_rows[n_event++] = i;
         w->time = t0;
-        if (any_contact) {
-            /* the event regime's pairs leave out the contact islands' bodies, and its kept end touches
-             * would not describe them */
+        if (any_excluded) {
+            /* the event regime's pairs leave out the contact islands' and the sleeping bodies, and its
+             * kept end touches would not describe them */
             w->excluded = excluded;
             lc_event_regime_forget_end(w->event);
         }
-        if (n_event == 0 && any_contact) {
-            /* every island was the contact regime's: no event pass (its broadphases would find nothing) */
+        if (n_event == 0 && any_excluded) {
+            /* every island was the contact regime's or asleep: no event pass (its broadphases would find
+             * nothing) */
             w->excluded = NULL;
             *marks_known = 1;
             w->time = step->time0 + dt;
@@ -160,7 +155,7 @@ static lc_status advance_islands(lc_world *w, const lc_step_try *step, double dt
             return LC_OK;
         }
         st = lc_event_advance(w, w->event, step, step->time0 + dt - t0, t0, event_rows, n_event, marks_known,
-                              w->def.regime == LC_REGIME_AUTO ? &handover : NULL, &t_handover);
+                              w->def.regime == LC_REGIME_AUTO && *built ? &handover : NULL, &t_handover);
         w->excluded = NULL;
         if (st != LC_OK || handover < 0) break;
         {
@@ -170,10 +165,10 @@ static lc_status advance_islands(lc_world *w, const lc_step_try *step, double dt
             st = contact_island(w, step, &isl, handover, step->time0 + dt - t0, stuck);
             if (st != LC_OK || *stuck) return st;
             for (i = 0; i < isl.nrows; ++i) excluded[isl.rows[i]] = 1;
-            any_contact = 1;
+            any_excluded = 1;
         }
     }
-    if (any_contact) lc_event_regime_forget_end(w->event);
+    if (any_excluded) lc_event_regime_forget_end(w->event);
     return st;
 }
 
@@ -233,19 +228,31 @@ lc_status lc_world_step(lc_world *w, double dt)
      * start */
     if (lc_regime_refresh(w) != 0 || lc_contact_regime_begin_step(w->contact) != 0)
         return lc_step_undo(w, &step, LC_ERR_NO_MEMORY, "out of memory during the step");
+    /* every body asleep: nothing moves, the sleeping contacts are reported again */
+    i = lc_sleep_begin_step(w->sleep, w);
+    if (i == 1) {
+        w->time = time0 + dt;
+        if (lc_sleep_end_step(w->sleep, w, NULL, dt) != 0)
+            return lc_step_undo(w, &step, LC_ERR_NO_MEMORY, "out of memory during the step");
+        lc_stage_end(w, &w->last.time_step, w->step_t0);
+        lc_counters_add(&w->total, &w->last);
+        w->error[0] = '\0';
+        return LC_OK;
+    }
+    if (i < 0) return lc_step_undo(w, &step, LC_ERR_NO_MEMORY, "out of memory during the step");
     memcpy(marks0, w->rests_dissipative, (size_t)w->count);
     /* Tries: a try whose bodies went where their islands' build did not foresee is taken again with
      * those islands grown to where they went (LC_MAX_ISLAND_TRIES at most); one whose contact island
      * ended overlapping for no such reason is taken again with that island in the event regime (once
      * per island: its rows stay marked for the step, so this ends). */
     for (try = 0;; ++try) {
-        int found = 0, stuck = 0;
-        st = advance_islands(w, &step, dt, reach, &marks_known, &stuck);
+        int found = 0, stuck = 0, built = 0;
+        st = advance_islands(w, &step, dt, reach, &marks_known, &stuck, &built);
         if (st != LC_OK) {
             memcpy(w->rests_dissipative, marks0, (size_t)w->count);
             return st;
         }
-        if (try < LC_MAX_ISLAND_TRIES - 1) {
+        if (built && try < LC_MAX_ISLAND_TRIES - 1) {
             if (reach == NULL) {
                 reach = lc_buf_get(&ss->reach, (size_t)w->count * 4 * sizeof(double));
                 if (reach == NULL) return lc_step_undo(w, &step, LC_ERR_NO_MEMORY, "out of memory during the step");
@@ -254,7 +261,7 @@ lc_status lc_world_step(lc_world *w, double dt)
                     reach[4 * i + 2] = -1.0;
                 }
             }
-            found = unforeseen_pairs(w, ss, backup, reach);
+            found = lc_islands_unforeseen(w, w->islands, backup, reach);
             if (found < 0) return lc_step_undo(w, &step, LC_ERR_NO_MEMORY, "out of memory during the step");
         }
         if (found == 0 && stuck) {
@@ -272,6 +279,9 @@ lc_status lc_world_step(lc_world *w, double dt)
         if (!isfinite(w->state[i])) return lc_step_undo(w, &step, LC_ERR_NUMERIC, "the state became non-finite");
     /* the marks describe the end state unless the event regime could not tell (the next step looks) */
     w->regime_edits = marks_known ? w->edits : w->edits - 1;
+    /* islands that rested long enough fall asleep */
+    if (lc_sleep_end_step(w->sleep, w, w->islands, dt) != 0)
+        return lc_step_undo(w, &step, LC_ERR_NO_MEMORY, "out of memory during the step");
     lc_stage_end(w, &w->last.time_step, w->step_t0);
     lc_counters_add(&w->total, &w->last);
     w->error[0] = '\0';

@@ -99,6 +99,9 @@
  * to 5e-3 m/s off), the step is taken again with solves of up to this many sweeps and exact ones up to
  * this many points (a 16-point problem: ~40 pivots, where the sweeps need 100-700). */
 #define LC_CONTACT_PRECISE_SWEEPS 1000
+/* Pivots the exact solver may take per unknown before it gives up (Lemke's pivoting cycles only on
+ * degenerate ties, which the lexicographic rule breaks; the cap is a guard). */
+#define LC_LEMKE_PIVOTS_PER_UNKNOWN 20
 #ifndef LC_CONTACT_PRECISE_EXACT_POINTS
 #define LC_CONTACT_PRECISE_EXACT_POINTS 32
 #endif

@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "world.h"
+#include "sleep.h"
 #include "islands.h"
 #include "contact_regime.h"
 #include "event_regime.h"
@@ -48,6 +49,13 @@ static lc_status ok(lc_world *w)
 {
     w->error[0] = '\0';
     return LC_OK;
+}
+
+/* ok() for a call that changed something a step reads: sleeping bodies wake (sleep.c) */
+static lc_status changed(lc_world *w)
+{
+    w->api_changes++;
+    return ok(w);
 }
 
 const char *lc_status_string(lc_status status)
@@ -104,6 +112,9 @@ lc_world_def lc_default_world_def(void)
     d.regime = LC_REGIME_AUTO;
     d.contact_iterations = 30;
     d.contact_tolerance = 1e-10;
+    d.allow_sleep = 0;
+    d.sleep_time = 0.5;
+    d.sleep_speed = 1e-4;
     return d;
 }
 
@@ -180,6 +191,11 @@ static lc_status validate_world_def(lc_world *w, const lc_world_def *d)
         return lc_fail(w, LC_ERR_BAD_ENUM, "regime = %d is not an lc_regime", (int)d->regime);
     CHECK_IRANGE(w, d->contact_iterations, 1, 1000000, "contact_iterations");
     CHECK_RANGE(w, d->contact_tolerance, 0.0, 1.0, "contact_tolerance");
+    CHECK_IRANGE(w, d->allow_sleep, 0, 1, "allow_sleep");
+    CHECK_FINITE(w, d->sleep_time, "sleep_time");
+    if (!(d->sleep_time > 0.0 && d->sleep_time <= 1e6))
+        return lc_fail(w, LC_ERR_OUT_OF_RANGE, "sleep_time = %g is outside (0, 1e6] s", d->sleep_time);
+    CHECK_RANGE(w, d->sleep_speed, 0.0, 10.0, "sleep_speed");
     return LC_OK;
 }
 
@@ -205,9 +221,10 @@ lc_world *lc_world_create(const lc_world_def *def, char *errbuf, size_t errbuf_l
         w->impulse = lc_impulse_state_create();
         w->sparse_lcp = lc_sparse_lcp_state_create();
         w->static_load = lc_static_load_state_create();
+        w->sleep = lc_sleep_create();
         w->lcp = lc_lcp_workspace_create();
         if (!w->step_state || !w->islands || !w->event || !w->contact || !w->broad_phase || !w->integrator ||
-            !w->contact_forces || !w->impulse || !w->sparse_lcp || !w->static_load || !w->lcp)
+            !w->contact_forces || !w->impulse || !w->sparse_lcp || !w->static_load || !w->sleep || !w->lcp)
             s = lc_fail(w, LC_ERR_NO_MEMORY, "out of memory");
     }
     if (s != LC_OK) {
@@ -239,6 +256,7 @@ void lc_world_destroy(lc_world *w)
     lc_impulse_state_destroy(w->impulse);
     lc_sparse_lcp_state_destroy(w->sparse_lcp);
     lc_static_load_state_destroy(w->static_load);
+    lc_sleep_destroy(w->sleep);
     lc_lcp_workspace_destroy(w->lcp);
     lc_buf_free(&w->b_pairs);
     lc_buf_free(&w->b_touch);
@@ -261,7 +279,7 @@ lc_status lc_world_set_def(lc_world *w, const lc_world_def *def)
     s = validate_world_def(w, def);
     if (s != LC_OK) return s;
     w->def = *def;
-    return ok(w);
+    return changed(w);
 }
 
 lc_status lc_world_set_gravity(lc_world *w, lc_vec2 g)
@@ -290,7 +308,7 @@ lc_status lc_world_set_elasticity(lc_world *w, double e)
     CHECK_RANGE(w, e, 0.0, 1.0, "elasticity");
     for (i = 0; i < w->count; ++i) w->elasticity[i] = e;
     w->edits++;
-    return ok(w);
+    return changed(w);
 }
 
 double lc_world_get_time(const lc_world *w) { return w ? w->time : 0.0; }
@@ -416,7 +434,7 @@ lc_status lc_world_add_body(lc_world *w, const lc_body_def *d, lc_body_id *out_i
     w->ext_torque[row] = 0.0;
     w->thruster_count[row] = 0;
     w->rests_dissipative[row] = 0;
-    return ok(w);
+    return changed(w);
 }
 
 lc_status lc_world_add_walls(lc_world *w, double xmin, double ymin, double xmax, double ymax,
@@ -467,7 +485,7 @@ lc_status lc_world_add_walls(lc_world *w, double xmin, double ymin, double xmax,
         }
     }
     if (out_ids) for (i = 0; i < 4; ++i) out_ids[i] = ids[i];
-    return ok(w);
+    return changed(w);
 }
 
 static void remove_springs_of(lc_world *w, lc_body_id id)
@@ -502,7 +520,7 @@ lc_status lc_world_remove_body(lc_world *w, lc_body_id id)
     remove_springs_of(w, id);
     w->contact_count = 0;
     lc_event_regime_rows_shifted(w->event);   /* kept touches refer to rows, which just shifted */
-    return ok(w);
+    return changed(w);
 }
 
 lc_status lc_world_get_state(const lc_world *w, lc_state_view *out)
@@ -538,7 +556,7 @@ lc_status lc_world_set_state(lc_world *w, const double *state, int count)
         if (!w->is_static[i]) memcpy(&w->state[i * 6], &state[i * 6], 6 * sizeof(double));
     w->contact_count = 0;
     w->edits++;
-    return ok(w);
+    return changed(w);
 }
 
 #define GET_ROW(w, id, row) \
@@ -558,7 +576,7 @@ lc_status lc_body_set_pose(lc_world *w, lc_body_id id, lc_vec2 center, double an
     w->state[row * 6 + SA] = angle;
     w->contact_count = 0;
     w->edits++;
-    return ok(w);
+    return changed(w);
 }
 
 lc_status lc_body_set_velocity(lc_world *w, lc_body_id id, lc_vec2 v, double omega)
@@ -571,7 +589,7 @@ lc_status lc_body_set_velocity(lc_world *w, lc_body_id id, lc_vec2 v, double ome
     w->state[row * 6 + SVY] = v.y;
     w->state[row * 6 + SW] = omega;
     w->edits++;
-    return ok(w);
+    return changed(w);
 }
 
 lc_status lc_body_set_mass(lc_world *w, lc_body_id id, double mass)
@@ -585,7 +603,7 @@ lc_status lc_body_set_mass(lc_world *w, lc_body_id id, double mass)
     w->inv_mass[row] = 1.0 / mass;
     w->inv_inertia[row] = 1.0 / w->inertia[row];
     w->edits++;
-    return ok(w);
+    return changed(w);
 }
 
 lc_status lc_body_set_material(lc_world *w, lc_body_id id, double e, double mu)
@@ -597,7 +615,7 @@ lc_status lc_body_set_material(lc_world *w, lc_body_id id, double e, double mu)
     w->elasticity[row] = e;
     w->friction[row] = mu;
     w->edits++;
-    return ok(w);
+    return changed(w);
 }
 
 lc_status lc_body_set_external(lc_world *w, lc_body_id id, lc_vec2 force, double torque)
@@ -608,7 +626,7 @@ lc_status lc_body_set_external(lc_world *w, lc_body_id id, lc_vec2 force, double
     CHECK_RANGE(w, torque, -1e12, 1e12, "torque");
     w->ext_force[row] = force;
     w->ext_torque[row] = torque;
-    return ok(w);
+    return changed(w);
 }
 
 int lc_body_vertex_count(const lc_world *w, lc_body_id id)
@@ -681,7 +699,7 @@ lc_status lc_body_add_thruster(lc_world *w, lc_body_id id, const lc_thruster_def
     t->level = 0.0;
     w->thruster_count[row] = k + 1;
     if (out_index) *out_index = k;
-    return ok(w);
+    return changed(w);
 }
 
 lc_status lc_body_add_default_thrusters(lc_world *w, lc_body_id id, double thrust, int *out_first)
@@ -710,7 +728,7 @@ lc_status lc_body_add_default_thrusters(lc_world *w, lc_body_id id, double thrus
     first = w->thruster_count[row];
     for (i = 0; i < 4; ++i) TRY(lc_body_add_thruster(w, id, &d[i], NULL));
     if (out_first) *out_first = first;
-    return ok(w);
+    return changed(w);
 }
 
 lc_status lc_body_set_thruster_level(lc_world *w, lc_body_id id, int index, double level)
@@ -721,7 +739,7 @@ lc_status lc_body_set_thruster_level(lc_world *w, lc_body_id id, int index, doub
         return lc_fail(w, LC_ERR_UNKNOWN_THRUSTER, "body %u has no thruster %d (it has %d)", (unsigned)id, index, w->thruster_count[row]);
     CHECK_RANGE(w, level, 0.0, 1.0, "thruster level");
     w->thrusters[row][index].level = level;
-    return ok(w);
+    return changed(w);
 }
 
 lc_status lc_body_set_thruster_mask(lc_world *w, lc_body_id id, uint32_t mask)
@@ -731,7 +749,7 @@ lc_status lc_body_set_thruster_mask(lc_world *w, lc_body_id id, uint32_t mask)
     if (w->thruster_count[row] < 32 && (mask >> w->thruster_count[row]) != 0)
         return lc_fail(w, LC_ERR_UNKNOWN_THRUSTER, "mask 0x%x names thrusters body %u does not have (it has %d)", (unsigned)mask, (unsigned)id, w->thruster_count[row]);
     for (i = 0; i < w->thruster_count[row]; ++i) w->thrusters[row][i].level = (mask >> i) & 1u ? 1.0 : 0.0;
-    return ok(w);
+    return changed(w);
 }
 
 int lc_body_thruster_count(const lc_world *w, lc_body_id id)
@@ -787,7 +805,7 @@ lc_status lc_world_add_spring(lc_world *w, const lc_spring_def *d, lc_spring_id 
     w->spring_count++;
     if (out_id) *out_id = w->next_spring_id;
     w->next_spring_id++;
-    return ok(w);
+    return changed(w);
 }
 
 lc_status lc_world_remove_spring(lc_world *w, lc_spring_id id)
@@ -797,7 +815,7 @@ lc_status lc_world_remove_spring(lc_world *w, lc_spring_id id)
     if (i < 0) return lc_fail(w, LC_ERR_UNKNOWN_SPRING, "no spring with id %u", (unsigned)id);
     memmove(&w->springs[i], &w->springs[i + 1], (size_t)(w->spring_count - i - 1) * sizeof *w->springs);
     w->spring_count--;
-    return ok(w);
+    return changed(w);
 }
 
 lc_status lc_spring_set_target(lc_world *w, lc_spring_id id, lc_vec2 target)
@@ -809,7 +827,7 @@ lc_status lc_spring_set_target(lc_world *w, lc_spring_id id, lc_vec2 target)
         return lc_fail(w, LC_ERR_OUT_OF_RANGE, "spring %u joins two bodies; it has no world target", (unsigned)id);
     TRY(check_vec(w, target, 1e9, "target"));
     w->springs[i].def.point_b = target;
-    return ok(w);
+    return changed(w);
 }
 
 lc_status lc_spring_set_params(lc_world *w, lc_spring_id id, double k, double d, double L0)
@@ -821,7 +839,7 @@ lc_status lc_spring_set_params(lc_world *w, lc_spring_id id, double k, double d,
     w->springs[i].def.stiffness = k;
     w->springs[i].def.damping = d;
     w->springs[i].def.rest_length = L0;
-    return ok(w);
+    return changed(w);
 }
 
 lc_status lc_spring_get_def(const lc_world *w, lc_spring_id id, lc_spring_def *out)

@@ -109,6 +109,7 @@ struct lc_world {
     struct lc_impulse_state *impulse;               /* impulse.c */
     struct lc_sparse_lcp_state *sparse_lcp;         /* sparse_lcp.c */
     struct lc_static_load_state *static_load;       /* static_load.c */
+    struct lc_sleep *sleep;                         /* sleep.c */
     /* the dense solver's workspace (lcp.c), shared by the dense solves of contact_forces.c, impulse.c and
      * event_projection.c: scratch that no solve holds past its return */
     lc_lcp_workspace *lcp;
@@ -119,6 +120,9 @@ struct lc_world {
     unsigned long edits;          /* bumped by every API call that changes bodies, their states or materials:
                                      a search kept from the last step holds only while it is unchanged */
     unsigned long regime_edits;   /* `edits` when rests_dissipative last described the state (regime.c, step.c) */
+    unsigned long api_changes;    /* bumped by every API call that changes anything a step reads (bodies,
+                                     states, materials, forces, thrusters, springs, settings): sleep.c wakes
+                                     every body when it moved */
     double step_dt;               /* dt of the step in progress (the stabilisation's time scale: integrator.c,
                                      contact_forces.c) */
     /* dynamic rows the broad phase and the event regime leave out of every pair while the event regime

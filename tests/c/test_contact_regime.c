@@ -4,7 +4,8 @@
  *  (1) the rule, per step: a block in flight is one island in the event regime; a block resting on
  *      the floor with e = 0.5 is one island in the contact regime; with e = 1 (both bodies) it stays
  *      in the event regime (e = 1 chains need the event regime's sequential impacts); a block on the
- *      floor moving farther than its own shortest edge in a step stays in the event regime;
+ *      floor moving farther than its own shortest edge in a step is taken in sub-steps that each move
+ *      it less (40 m/s: two), and stays in the event regime beyond 16 (600 m/s);
  *      regime = EVENT and regime = CONTACT force every island into that regime;
  *  (2) islands: two blocks resting 5 m apart are two islands, two blocks resting side by side and
  *      touching are one;
@@ -85,12 +86,20 @@ static void rule(void)
     CHECK(c.islands == 1 && c.contact_islands == 0, "a resting block at e = 1 stays event (%llu contact islands)",
           (unsigned long long)c.contact_islands);
     lc_world_destroy(w);
-    /* faster than its shortest edge (0.5 m) per step: 40 m/s x 1/60 s = 0.67 m */
+    /* faster than its shortest edge (0.5 m) per step: 40 m/s x 1/60 s = 0.67 m, two sub-steps */
     w = world_with_floor(LC_REGIME_AUTO, 0.5);
     if (!w) return;
     block(w, 0.0, rest_y, 40.0, 0.5);
     c = run(w, 1);
-    CHECK(c.contact_islands == 0, "a block sliding at 40 m/s stays event (%llu contact islands)",
+    CHECK(c.contact_islands == 2 && c.islands == 1, "a block sliding at 40 m/s is taken in two contact sub-steps "
+          "(%llu contact island steps)", (unsigned long long)c.contact_islands);
+    lc_world_destroy(w);
+    /* more than LC_CONTACT_MAX_SUBSTEPS (16) shortest edges per step: 600 m/s x 1/60 s = 20 edges */
+    w = world_with_floor(LC_REGIME_AUTO, 0.5);
+    if (!w) return;
+    block(w, 0.0, rest_y, 600.0, 0.5);
+    c = run(w, 1);
+    CHECK(c.contact_islands == 0, "a block sliding at 600 m/s stays event (%llu contact islands)",
           (unsigned long long)c.contact_islands);
     lc_world_destroy(w);
     /* forced regimes */

@@ -123,6 +123,11 @@ typedef struct lc_world_def {
                                       smaller one may take proportionally more), [1, 1e6], default 30 */
     double contact_tolerance;      /* contact regime: m/s, a solve stops at a sweep that changes no point's
                                       velocity by more than this, [0, 1], default 1e-10 */
+    int allow_sleep;               /* 1: islands at rest are not advanced until something reaches them
+                                      (docs/contact_regime.md, "Sleep"), default 0 */
+    double sleep_time;             /* s a body must rest before its island may sleep, (0, 1e6], default 0.5 */
+    double sleep_speed;            /* m/s, a body rests while its centre and its farthest point move slower
+                                      than this, [0, 10], default 1e-4 */
 } lc_world_def;
 
 /* A body. Start from lc_default_body_def(). Vertices are in the body's local frame; the centre of
@@ -239,6 +244,8 @@ typedef struct lc_counters {
                                          (docs/contact_regime.md, "Guarantees") */
     double max_unresolved_overlap;    /* m, deepest overlap such a step left */
     double max_unresolved_energy;     /* J, largest energy gain such a step kept */
+    uint64_t bodies_asleep;           /* bodies asleep at the end of the step (last; the total sums them) */
+    uint64_t islands_woken;           /* islands of sleeping bodies woken by an awake body reaching them */
     double max_contact_residual;      /* m/s, largest residual of a contact-regime solve (its stopping rule) */
     double max_lcp_residual;          /* largest residual of an iterative contact-force solve: relative for
                                          groups up to lcp_exact_max, m/s^2 of relative acceleration above */
