@@ -10,6 +10,15 @@
  * went, and the step is taken again. Rare; the last try is kept. */
 #define LC_MAX_ISLAND_TRIES 4
 
+/* How much farther than its predicted path the island build looks around a body that rests on a
+ * dissipative contact, as a fraction of its shortest edge: in a pile, contact impulses move a body off
+ * the path its start velocity predicts (a box dropped at 8 m/s on a base-12 pyramid spread the rows
+ * sideways by up to 3 mm a step), and a neighbour that then closes in unpaired costs the whole step
+ * again. A twentieth of a 0.3-1 m box (15-50 mm) covers that; the price is a few more candidate pairs. */
+#ifndef LC_ISLAND_MARGIN   /* -D to measure */
+#define LC_ISLAND_MARGIN 0.05
+#endif
+
 /* Impacts of pairs that are not perfectly elastic the event regime resolves in one step before it hands
  * the island of the last one to the contact regime: a block bouncing ever lower at e < 1 makes
  * impacts without end when no speed threshold stops them (restitution_threshold and resting_speed
