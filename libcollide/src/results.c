@@ -2,17 +2,22 @@
 #include <stdlib.h>
 #include "world.h"
 
-int lc_push_contact(lc_world *w, const lc_touch *t, lc_contact_kind kind)
+lc_contact *lc_new_contact(lc_world *w)
 {
-    lc_contact *c;
     if (w->contact_count == w->contact_cap) {
         int cap = w->contact_cap ? 2 * w->contact_cap : 32;
         void *p = realloc(w->contacts, (size_t)cap * sizeof *w->contacts);
-        if (p == NULL) return -1;
+        if (p == NULL) return NULL;
         w->contacts = p;
         w->contact_cap = cap;
     }
-    c = &w->contacts[w->contact_count++];
+    return &w->contacts[w->contact_count++];
+}
+
+int lc_push_contact(lc_world *w, const lc_touch *t, lc_contact_kind kind)
+{
+    lc_contact *c = lc_new_contact(w);
+    if (c == NULL) return -1;
     c->body_a = w->ids[t->a];
     c->body_b = w->ids[t->b];
     c->point = t->p;

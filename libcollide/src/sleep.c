@@ -102,16 +102,10 @@ static int sleeping_contact(const lc_world *w, const uint8_t *asleep, const lc_c
 
 static int append_contact(lc_world *w, const lc_contact *c)
 {
-    if (w->contact_count == w->contact_cap) {
-        int cap = w->contact_cap ? 2 * w->contact_cap : 32;
-        void *p = realloc(w->contacts, (size_t)cap * sizeof *w->contacts);
-        if (p == NULL) return -1;
-        w->contacts = p;
-        w->contact_cap = cap;
-    }
-    w->contacts[w->contact_count] = *c;
-    w->contacts[w->contact_count].time = w->time;
-    w->contact_count++;
+    lc_contact *slot = lc_new_contact(w);
+    if (slot == NULL) return -1;
+    *slot = *c;
+    slot->time = w->time;
     return 0;
 }
 

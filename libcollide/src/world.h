@@ -307,6 +307,8 @@ typedef struct lc_step_try {
 lc_status lc_step_undo(lc_world *w, const lc_step_try *step, lc_status s, const char *what);
 
 /* ---- results.c ---- */
+/* A new slot at the end of the step's contacts (grown as needed), or NULL without memory. */
+lc_contact *lc_new_contact(lc_world *w);
 /* Appends a contact of the step in progress (a touch at its current geometry). 0, or -1 without memory. */
 int lc_push_contact(lc_world *w, const lc_touch *t, lc_contact_kind kind);
 /* Adds a step's counters to the running totals (the max_* fields take the larger). */
