@@ -5,6 +5,7 @@ dropped into a walled box (`node_bench.pile_scene`). This script builds the same
 Python binding (no ROS, no publishing) and times `World.step` (one `lc_world_step`) at the node's
 default time step (1 ms) from the drop on. Per --bin seconds of sim time it prints the median and mean
 wall time of a step, the kinetic energy of the boxes at the bin's end (is the pile still tumbling?),
+the collisions per step over the bin and the median speed of the boxes at its end (does it rest?),
 the islands and contact-regime islands of the last step, and the share of the step time each
 pipeline stage took (`World.set_stage_timing(True)`: detection, integration, time-of-impact search,
 impulses, projection, contact regime; docs/contact_regime.md). The last line gives the medians over
@@ -57,12 +58,13 @@ def main() -> int:
     per_bin = max(1, int(round(a.bin / a.dt)))
     steps = int(round(a.until / a.dt))
     print(f"{int(dyn.sum())} dynamic bodies, dt {a.dt} s, libcollide {collide.version()}")
-    print("| sim t (s) | step median (ms) | step mean (ms) | KE end (J) | islands / contact | "
-          + " / ".join(STAGES) + " (% of step) |")
-    print("|---|---|---|---|---|---|")
+    print("| sim t (s) | step median (ms) | step mean (ms) | KE end (J) | collisions per step | median speed (mm/s) "
+          "| islands / contact | " + " / ".join(STAGES) + " (% of step) |")
+    print("|---|---|---|---|---|---|---|---|")
     all_times: list[float] = []
     t_start = time.perf_counter()
     s0 = stage_times(world)
+    hits0 = world.counters(last=False)["collisions"]
     for k in range(steps):
         t0 = time.perf_counter()
         world.step(a.dt)
@@ -73,9 +75,14 @@ def main() -> int:
             share = 100.0 * (s1[1:] - s0[1:]) / max(s1[0] - s0[0], 1e-12)
             s0 = s1
             c = world.counters(last=True)
+            hits1 = world.counters(last=False)["collisions"]
+            st = np.asarray(world.state)[dyn]
+            speed = 1e3 * float(np.median(np.hypot(st[:, 3], st[:, 4])))
             print(f"| {world.time:.2f} | {1e3 * statistics.median(seg):.3f} | {1e3 * statistics.fmean(seg):.3f} "
-                  f"| {kinetic_energy(world, dyn, m, inertia):.3g} | {c['islands']} / {c['contact_islands']} | "
+                  f"| {kinetic_energy(world, dyn, m, inertia):.3g} | {(hits1 - hits0) / len(seg):.2f} | {speed:.3g} "
+                  f"| {c['islands']} / {c['contact_islands']} | "
                   + " / ".join(f"{x:.0f}" for x in share) + " |", flush=True)
+            hits0 = hits1
         if time.perf_counter() - t_start > a.wall:
             print(f"stopped after {a.wall:g} s of wall time")
             break
