@@ -55,7 +55,8 @@
 #endif
 /* The cost of those evaluations and passes: matrix entries the complementarity solves visited
  * (lc_counters.solver_work), per body of the world. The engine undoes a step past 1e9 per body
- * (libcollide/src/tunables.h); twice that means its cap failed to stop one (finding 32: 1.7e10, 110 s). */
+ * (libcollide/src/tunables.h); twice that means its cap failed to stop one (1.7e10 and 110 s for
+ * corpus/step-regressions/slow-solver-work-coincident-tiny-decagons without it). */
 #ifndef FZ_MAX_SOLVER_WORK_PER_BODY
 #define FZ_MAX_SOLVER_WORK_PER_BODY 2e9
 #endif

@@ -67,8 +67,9 @@ int lc_contact_energy_blew_up(const lc_world *w, const double *s0, const double 
  * more energy than it started with, beyond 1 J + 1e-3 of it plus ten times that bound on the driving
  * forces' work (with |v| the larger of the body's speeds at the step's two ends, and the |F|^2 dt^2 / m
  * a force adds from rest), has blown up: a 1e-12 m, 10 kg polygon at 1e6 m/s pushed by an external
- * force in a 12 m box went to 5.7e21 m/s within one 22 ms step and left the box (fuzz finding 26; no
- * single trial interval doubled its energy, which the per-interval check above looks for). A real
+ * force in a 12 m box went to 5.7e21 m/s within one 22 ms step and left the box (regression input
+ * fuzz/corpus/step-regressions/energy-pushed-1e-12m-polygon-1e6ms-leaves-box; no single trial
+ * interval doubled its energy, which the per-interval check above looks for). A real
  * driving force's work grows with the speed, the blow-up's energy with its square. Measured before
  * the end-of-step projection, which may lift overlapping bodies against gravity; a step that starts
  * with bodies deep in each other is left to the projection. */

@@ -62,7 +62,8 @@
 #endif
 /* and the complementarity solves' work (lc_counters.solver_work), per body of the world: one force
  * evaluation of four coincident decagons (a 120-row dense group) costs 150 of the settling scene's
- * (20 blocks), so evaluations alone let such a step run 110 s to their cap (fuzz finding 32).
+ * (20 blocks), so evaluations alone let such a step run 110 s to their cap (regression input
+ * fuzz/corpus/step-regressions/slow-solver-work-coincident-tiny-decagons).
  * Measured per body (bench/repro/solver_work_per_body.py): the hardest legitimate step, a box dropped
  * onto a 78-box frictional pyramid, does 1.1e8 (10.5 s of CPU), the bench scenes at most 3e5; that
  * input did 1.7e10 by the evaluation cap, and now stops at 1e9 after 3 s. */
@@ -170,8 +171,9 @@
  * The speed threshold keeps a slow creep (a frictionless pile drifting at 1e-6 m/s) from loosening
  * its own tolerance: at 1 cm/s the pile's slow settling after that impact took 820 s, at 1 mm/s
  * 161 s. The ceiling bounds what a fast body can loosen: a 1e-11 m sliver at 1e6 m/s (dt 1e-3)
- * made the tolerance 1e5 m/s^2 and a step ran to LC_MAX_FORCE_EVALUATIONS_PER_STEP (docs/
- * hardening.md, finding 30); with the ceiling the input takes 0.08 s. */
+ * made the tolerance 1e5 m/s^2 and a step ran to LC_MAX_FORCE_EVALUATIONS_PER_STEP (regression input
+ * fuzz/corpus/step-regressions/slow-motion-tolerance-fast-sliver-exact-max-0); with the ceiling
+ * the input takes 0.08 s. */
 #define LC_MOTION_TOLERANCE 1e-4
 #define LC_MOTION_TOLERANCE_CEILING 1e-3
 /* Most alternations between the normal and the friction rows of a small group (contact_forces.c). */
@@ -201,7 +203,9 @@
  * with a wall corner's touch 3e4 m from its centre (inverse inertia 8.6e21) gave its group
  * ||A|| ~ 1e28 against a smallest scale ~0.1: past round-off, the expansion steps grew the
  * violation to 1e28-1e153 m/s^2 in every solve until the budget, and one step took 142 s to reach
- * the evaluation cap (fuzz finding 31; 0.01 s with this). The violation of a sound solve is not
+ * the evaluation cap (regression input
+ * fuzz/corpus/step-regressions/slow-solver-diverged-tiny-polygon-exact-max-0; 0.01 s with this).
+ * The violation of a sound solve is not
  * monotone either: in the seven scenes of bench/repro/same_bits.c (790 000 solves) it rose up to
  * 1e5-1e6 times above its best, and a threshold of 1e5 changes the settling scene's state hash;
  * at 1e6, and at 1e8, 100x above that, every hash is the one of the solver without the check. */
