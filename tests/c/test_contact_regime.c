@@ -57,66 +57,49 @@ static lc_counters run(lc_world *w, int n)
     return c;
 }
 
+/* The counters of the last of `steps` steps of one block (elasticity e, its floor's too, at height y,
+ * sliding at vx) on the floor in `regime`. 0 if the world could not be made. */
+static int one_block(lc_regime regime, double e, double y, double vx, int steps, lc_counters *c)
+{
+    lc_world *w = world_with_floor(regime, e);
+    if (!w) return 0;
+    block(w, 0.0, y, vx, e);
+    *c = run(w, steps);
+    lc_world_destroy(w);
+    return 1;
+}
+
 static void rule(void)
 {
-    lc_world *w;
     lc_counters c;
     double rest_y = 0.25 + 1e-7;
     /* in flight */
-    w = world_with_floor(LC_REGIME_AUTO, 0.5);
-    if (!w) return;
-    block(w, 0.0, 3.0, 0.0, 0.5);
-    c = run(w, 1);
+    if (!one_block(LC_REGIME_AUTO, 0.5, 3.0, 0.0, 1, &c)) return;
     CHECK(c.islands == 1 && c.contact_islands == 0, "a block in flight: %llu islands, %llu in the contact regime",
           (unsigned long long)c.islands, (unsigned long long)c.contact_islands);
-    lc_world_destroy(w);
     /* resting, e = 0.5 */
-    w = world_with_floor(LC_REGIME_AUTO, 0.5);
-    if (!w) return;
-    block(w, 0.0, rest_y, 0.0, 0.5);
-    c = run(w, 3);
+    if (!one_block(LC_REGIME_AUTO, 0.5, rest_y, 0.0, 3, &c)) return;
     CHECK(c.islands == 1 && c.contact_islands == 1, "a resting block at e = 0.5: %llu islands, %llu contact",
           (unsigned long long)c.islands, (unsigned long long)c.contact_islands);
-    lc_world_destroy(w);
     /* resting, e = 1 */
-    w = world_with_floor(LC_REGIME_AUTO, 1.0);
-    if (!w) return;
-    block(w, 0.0, rest_y, 0.0, 1.0);
-    c = run(w, 3);
+    if (!one_block(LC_REGIME_AUTO, 1.0, rest_y, 0.0, 3, &c)) return;
     CHECK(c.islands == 1 && c.contact_islands == 0, "a resting block at e = 1 stays event (%llu contact islands)",
           (unsigned long long)c.contact_islands);
-    lc_world_destroy(w);
     /* faster than its shortest edge (0.5 m) per step: 40 m/s x 1/60 s = 0.67 m, two sub-steps */
-    w = world_with_floor(LC_REGIME_AUTO, 0.5);
-    if (!w) return;
-    block(w, 0.0, rest_y, 40.0, 0.5);
-    c = run(w, 1);
+    if (!one_block(LC_REGIME_AUTO, 0.5, rest_y, 40.0, 1, &c)) return;
     CHECK(c.contact_islands == 2 && c.islands == 1, "a block sliding at 40 m/s is taken in two contact sub-steps "
           "(%llu contact island steps)", (unsigned long long)c.contact_islands);
-    lc_world_destroy(w);
     /* more than LC_CONTACT_MAX_SUBSTEPS (16) shortest edges per step: 600 m/s x 1/60 s = 20 edges */
-    w = world_with_floor(LC_REGIME_AUTO, 0.5);
-    if (!w) return;
-    block(w, 0.0, rest_y, 600.0, 0.5);
-    c = run(w, 1);
+    if (!one_block(LC_REGIME_AUTO, 0.5, rest_y, 600.0, 1, &c)) return;
     CHECK(c.contact_islands == 0, "a block sliding at 600 m/s stays event (%llu contact islands)",
           (unsigned long long)c.contact_islands);
-    lc_world_destroy(w);
     /* forced regimes */
-    w = world_with_floor(LC_REGIME_EVENT, 0.5);
-    if (!w) return;
-    block(w, 0.0, rest_y, 0.0, 0.5);
-    c = run(w, 3);
+    if (!one_block(LC_REGIME_EVENT, 0.5, rest_y, 0.0, 3, &c)) return;
     CHECK(c.contact_islands == 0 && c.contact_solves > 0, "regime EVENT: %llu contact islands, %llu force solves",
           (unsigned long long)c.contact_islands, (unsigned long long)c.contact_solves);
-    lc_world_destroy(w);
-    w = world_with_floor(LC_REGIME_CONTACT, 0.5);
-    if (!w) return;
-    block(w, 0.0, 3.0, 0.0, 0.5);
-    c = run(w, 1);
+    if (!one_block(LC_REGIME_CONTACT, 0.5, 3.0, 0.0, 1, &c)) return;
     CHECK(c.contact_islands == 1, "regime CONTACT: a block in flight in the contact regime (%llu)",
           (unsigned long long)c.contact_islands);
-    lc_world_destroy(w);
 }
 
 static void islands(void)
