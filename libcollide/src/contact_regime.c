@@ -410,6 +410,8 @@ static int flow(island_ctx *c, const lc_touch *t, int nt, double h, lc_contact_r
     double gc = w->def.contact_gap;
     int i, nb = c->b.n;
     uint8_t *known = lc_buf_get(&c->cr->b_known, (size_t)(nt > 0 ? nt : 1));
+    /* the whole cone below the slip speed (tunables.h): a pile's points need it to stick */
+    double slip_speed = c->small || c->precise ? LC_CONTACT_SLIP_SPEED : LC_CONTACT_PILE_SLIP_SPEED;
     if (known == NULL) return -1;
     for (i = 0; i < nb * 3; ++i) c->b.v[i] = c->b.v0[i] + h * c->b.acc[i];
     for (i = 0; i < nt; ++i) {
@@ -418,7 +420,7 @@ static int flow(island_ctx *c, const lc_touch *t, int nt, double h, lc_contact_r
         make_row(c, &t[i], r);
         lc_contact_row_velocity(r, c->b.v0, &un, &ut);
         r->target_n = -un - 2.0 * fmax(t[i].gap - gc, 0.0) / h;
-        r->slip = ut > LC_CONTACT_SLIP_SPEED ? 1 : ut < -LC_CONTACT_SLIP_SPEED ? -1 : 0;
+        r->slip = ut > slip_speed ? 1 : ut < -slip_speed ? -1 : 0;
         known[i] = (uint8_t)lc_contact_cache_find(c->cr->cache, key_of(w, &t[i]), &fn, &ft);
         if (known[i]) {
             r->lambda_n = fn * h;

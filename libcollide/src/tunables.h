@@ -98,6 +98,12 @@
  * cone's work on such a point is at most mu lambda_n times this: 1e-9 J for a 1 kg body at dt 1/60
  * (resting_speed, 1e-4 m/s by default and up to 10, made it up to 7e-5 J in one step of a pile). */
 #define LC_CONTACT_SLIP_SPEED 1e-6
+/* m/s, the same for an island of several bodies (its first, not its precise, solve): there the points
+ * of a settling pile slip to and fro at ~1 mm/s, and friction held to one side of its cone lets every
+ * point that reverses within a step slide freely; such a pile never came to rest. Below this the whole
+ * cone acts; the work that can do beyond the one-sided rule (at most mu lambda_n times this per point)
+ * is what the energy guard takes back from the island's motion (contact_regime.c). */
+#define LC_CONTACT_PILE_SLIP_SPEED 1e-3
 /* A solve of m points fewer than this may take contact_iterations x this / m sweeps: the work of one of
  * this size. A few bodies whose friction and normal impulses trade through their rotation need 40-60
  * sweeps where a large pile's warm-started solve needs a few; cut at contact_iterations, such an island
