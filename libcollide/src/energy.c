@@ -1,5 +1,5 @@
-/* Energy split as on the seed's bar graph (translational, rotational, gravitational, spring) and momentum,
- * and the energy balances that tell a step which has blown up. */
+/* Energy split as on the seed's bar graph (translational, rotational, gravitational, spring) and momentum
+ * (lc_world_get_energy), and the energy balances that tell a step which has blown up. */
 #include <math.h>
 #include "world.h"
 
@@ -27,6 +27,14 @@ void lc_compute_energy(const lc_world *w, const double *state, lc_energy *out)
     }
     out->spring = lc_spring_energy(w, state);
     out->total = out->translational + out->rotational + out->gravitational + out->spring;
+}
+
+lc_status lc_world_get_energy(const lc_world *w, lc_energy *out)
+{
+    if (w == NULL) return LC_ERR_NULL;
+    if (out == NULL) return lc_fail((lc_world *)w, LC_ERR_NULL, "out is NULL");
+    lc_compute_energy(w, w->state, out);
+    return LC_OK;
 }
 
 /* Contact forces do no work beyond round-off; a trial interval in which the bodies they act on gain

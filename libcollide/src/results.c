@@ -83,3 +83,20 @@ void lc_counters_add(lc_counters *total, const lc_counters *last)
     total->time_contact_forces += last->time_contact_forces;
     total->time_contact_regime += last->time_contact_regime;
 }
+
+lc_status lc_world_get_contacts(const lc_world *w, const lc_contact **out, int *out_count)
+{
+    if (w == NULL) return LC_ERR_NULL;
+    if (out == NULL || out_count == NULL) return lc_fail((lc_world *)w, LC_ERR_NULL, "out or out_count is NULL");
+    *out = w->contacts;
+    *out_count = w->contact_count;
+    return LC_OK;
+}
+
+lc_status lc_world_get_counters(const lc_world *w, lc_counters *last, lc_counters *total)
+{
+    if (w == NULL) return LC_ERR_NULL;
+    if (last) *last = w->last;
+    if (total) *total = w->total;
+    return LC_OK;
+}

@@ -138,6 +138,39 @@ void lc_buf_free(lc_buf *b);
 /* ---- errors ---- */
 lc_status lc_fail(lc_world *w, lc_status s, const char *fmt, ...);
 
+/* ---- the API's argument checks (world.c, body.c, thruster.c, spring.c) ---- */
+/* Each returns lc_fail's status from the calling API function when the check fails. */
+#define LC_CHECK_FINITE(w, val, name) \
+    do { if (!isfinite(val)) return lc_fail((w), LC_ERR_NOT_FINITE, "%s is not finite (%g)", (name), (double)(val)); } while (0)
+#define LC_CHECK_RANGE(w, val, lo, hi, name) \
+    do { LC_CHECK_FINITE(w, val, name); \
+         if ((val) < (lo) || (val) > (hi)) return lc_fail((w), LC_ERR_OUT_OF_RANGE, "%s = %g is outside [%g, %g]", (name), (double)(val), (double)(lo), (double)(hi)); } while (0)
+#define LC_CHECK_IRANGE(w, val, lo, hi, name) \
+    do { if ((val) < (lo) || (val) > (hi)) return lc_fail((w), LC_ERR_OUT_OF_RANGE, "%s = %d is outside [%d, %d]", (name), (int)(val), (int)(lo), (int)(hi)); } while (0)
+/* row = the row of body `id`, or return LC_ERR_NULL or LC_ERR_UNKNOWN_BODY; LC_GET_DYNAMIC_ROW also
+ * returns LC_ERR_STATIC_BODY for a static body. */
+#define LC_GET_ROW(w, id, row) \
+    do { if ((w) == NULL) return LC_ERR_NULL; (row) = lc_world_body_index((w), (id)); \
+         if ((row) < 0) return lc_fail((w), LC_ERR_UNKNOWN_BODY, "no body with id %u", (unsigned)(id)); } while (0)
+#define LC_GET_DYNAMIC_ROW(w, id, row) \
+    do { LC_GET_ROW(w, id, row); if ((w)->is_static[row]) return lc_fail((w), LC_ERR_STATIC_BODY, "body %u is static", (unsigned)(id)); } while (0)
+/* Returns expr's status from the calling function unless it is LC_OK. */
+#define LC_TRY(expr) do { lc_status s_ = (expr); if (s_ != LC_OK) return s_; } while (0)
+/* LC_CHECK_RANGE of both components of v over [-limit, limit], named "<name>.x" and "<name>.y". */
+lc_status lc_check_vec(lc_world *w, lc_vec2 v, double limit, const char *name);
+/* The success of an API call that changed something a step reads: clears the message, and sleeping
+ * bodies wake (sleep.c reads api_changes). */
+static inline lc_status lc_changed(lc_world *w)
+{
+    w->api_changes++;
+    w->error[0] = '\0';
+    return LC_OK;
+}
+
+/* ---- spring.c ---- */
+/* Drops the springs attached to body `id` (lc_world_remove_body). */
+void lc_remove_springs_of(lc_world *w, lc_body_id id);
+
 /* ---- polygon.c ---- */
 lc_status lc_shape_build(lc_shape *out, const lc_vec2 *v, int count, char *why, size_t why_len);
 
