@@ -2,7 +2,7 @@
 bodies and for 200 boxes tumbling with friction.
 
     source scripts/env.sh && nice python bench/node_bench.py [--seconds 5] [--windows 3] [--trials 25]
-                                                             [--drop-seconds 3] [--bodies 6 1000 pile200]
+                                                             [--drop-seconds 3] [--bodies 6 1000 pile200 pile200@0.005]
 
 For each case a node runs in its own process at the node's default parameters (given explicitly on its
 command line): 1 kHz physics (time_step 0.001 s), 100 Hz poses/states, 50 Hz /tf, 20 Hz markers,
@@ -19,7 +19,8 @@ latency: after ~/reset, one WrenchStamped is published on block1/thrust (block1 
 wall time from publish to the first bodies/poses message in which block1 has moved (median and 90th
 percentile over --trials).
 
-Cases (--bodies; default 6 1000 pile200):
+Cases (--bodies; default 6 1000 pile200 pile200@0.005; a case may end in @ and the node's time_step in
+seconds, default 0.001):
 - 6: the default scene with blocks:=6; --windows windows of --seconds wall seconds.
 - 1000 (any n > 6): a generated scene (walls around [-40, 40]^2, 0.5 m boxes on a 2 m grid, random
   speeds up to 0.5 m/s, e = 1, no gravity) with block1 at rest in a free corner; windows as for 6.
@@ -35,6 +36,10 @@ Cases (--bodies; default 6 1000 pile200):
   measured until the poses' stamps are --drop-seconds (3 s) of sim time past the drop: the fall,
   the pile-up and its tumbling until it comes to rest; --windows drops. Its latency trials start right
   after a reset, while the boxes are still falling (the cheap part of a drop).
+- pile200@0.005: the same drops at a 5 ms time step. The contact regime's cost per step grows slowly
+  with the step, so a pile's cost per simulated second falls with it (the engine alone:
+  `python bench/repro/pile200_engine_steps.py --dt 0.005`); 1 ms is the node's default for the seed's
+  exact impacts, not what a pile needs.
 Scene files are written into a temp dir and removed. Prints a markdown table and, per case, the
 real-time factor from the stamps, how many /diagnostics messages were used, steps/s and contacts,
 after naming the libcollide each node loaded. Not run by the tests (timings). Where the pile's time
@@ -63,7 +68,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "ros_pkg"))
 sys.path.insert(0, str(ROOT / "tests" / "python"))
 
-DEFAULT_CASES = ("6", "1000", "pile200")
+DEFAULT_CASES = ("6", "1000", "pile200", "pile200@0.005")
 
 
 def pick_domain() -> object | None:
@@ -188,23 +193,33 @@ class Case:
     label: str
     bodies: int
     pile: bool
+    time_step: float = 0.001  # s, the node's time_step parameter
 
 
 def parse_case(text: str) -> Case:
-    """'6' (default scene, 1-6 blocks), '1000' (any n > 6: big_scene) or 'pile200' (pile_scene of 200)."""
-    if text.startswith("pile") and text[4:].isdigit() and int(text[4:]) > 0:
-        return Case(text, int(text[4:]), True)
-    if text.isdigit() and int(text) > 0:
-        return Case(text, int(text), False)
-    raise argparse.ArgumentTypeError(f"'{text}': expected a body count (6, 1000, ...) or pileN (pile200)")
+    """'6' (default scene, 1-6 blocks), '1000' (any n > 6: big_scene) or 'pile200' (pile_scene of 200),
+    each optionally followed by '@' and the node's time_step in seconds ('pile200@0.005'; default 0.001)."""
+    body, _, dt_text = text.partition("@")
+    try:
+        dt = float(dt_text) if dt_text else 0.001
+    except ValueError:
+        dt = float("nan")
+    if not (0.0 < dt <= 0.1):
+        raise argparse.ArgumentTypeError(f"'{text}': time step after '@' must be a number in (0, 0.1] s")
+    if body.startswith("pile") and body[4:].isdigit() and int(body[4:]) > 0:
+        return Case(text, int(body[4:]), True, dt)
+    if body.isdigit() and int(body) > 0:
+        return Case(text, int(body), False, dt)
+    raise argparse.ArgumentTypeError(f"'{text}': expected a body count (6, 1000, ...) or pileN (pile200), "
+                                     "optionally @time_step")
 
 
 def node_args(case: Case, tmp: Path) -> list[str]:
     """The node's command line for a case; scene files are written into tmp."""
-    args = ["-p", "time_step:=0.001", "-p", "state_rate:=100.0", "-p", "tf_rate:=50.0",
+    args = ["-p", f"time_step:={case.time_step!r}", "-p", "state_rate:=100.0", "-p", "tf_rate:=50.0",
             "-p", "marker_rate:=20.0", "-p", "real_time_factor:=1.0"]
     if case.pile:
-        path = tmp / f"bench_{case.label}.yaml"
+        path = tmp / f"bench_pile{case.bodies}.yaml"
         path.write_text(yaml.safe_dump(pile_scene(case.bodies)))
     elif case.bodies > 6:
         path = tmp / f"bench_{case.bodies}.yaml"
@@ -351,13 +366,14 @@ def run_case(case: Case, seconds: float, windows: int, trials: int, drop_seconds
 
 
 def print_table(cases: list[Case], rows: list[dict[str, float]], drop_seconds: float) -> None:
-    print(f"\nsim node, 1 kHz physics, 100 Hz poses/states, 50 Hz tf, 20 Hz markers, RTF 1; "
+    print(f"\nsim node, time_step as given per case (default 1 ms), 100 Hz poses/states, 50 Hz tf, 20 Hz markers, RTF 1; "
           f"{os.cpu_count()} cores; ROS_DOMAIN_ID {os.environ['ROS_DOMAIN_ID']}; medians\n")
     print("| bodies | node CPU (% of a core) | poses received (Hz) | real-time factor | real time (>= 0.99) "
           "| step (ms) | publishing per step (ms) | command -> pose p50 / p90 (ms) | trials |")
     print("|---|---|---|---|---|---|---|---|---|")
     for case, r in zip(cases, rows):
         name = f"{case.bodies} (pile, first {drop_seconds:g} s of each drop)" if case.pile else str(case.bodies)
+        name += f", dt {case.time_step * 1e3:g} ms"
         rtf = r["real_time_factor"]
         holds = "n/a (no diagnostics)" if np.isnan(rtf) else "yes" if rtf >= 0.99 else "no"
         print(f"| {name} | {r['cpu_percent']:.1f} | {r['poses_hz']:.1f} | {r['real_time_factor']:.3f} | {holds} "
