@@ -199,9 +199,9 @@ class Case:
 def parse_case(text: str) -> Case:
     """'6' (default scene, 1-6 blocks), '1000' (any n > 6: big_scene) or 'pile200' (pile_scene of 200),
     each optionally followed by '@' and the node's time_step in seconds ('pile200@0.005'; default 0.001)."""
-    body, _, dt_text = text.partition("@")
+    body, at, dt_text = text.partition("@")
     try:
-        dt = float(dt_text) if dt_text else 0.001
+        dt = float(dt_text) if at else 0.001
     except ValueError:
         dt = float("nan")
     if not (0.0 < dt <= 0.1):

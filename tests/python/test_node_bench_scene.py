@@ -102,6 +102,8 @@ def test_nothing_overlaps_at_start(scene: dict[str, Any]) -> None:
 def test_parse_case() -> None:
     assert nb.parse_case("pile200") == nb.Case("pile200", 200, True)
     assert nb.parse_case("1000") == nb.Case("1000", 1000, False)
-    for bad in ("pile", "pile0", "0", "boxes"):
+    assert nb.parse_case("pile200@0.005") == nb.Case("pile200@0.005", 200, True, 0.005)
+    assert nb.parse_case("pile200").time_step == 0.001
+    for bad in ("pile", "pile0", "0", "boxes", "pile200@", "pile200@x", "pile200@0", "pile200@1", "6@-1"):
         with pytest.raises(Exception):
             nb.parse_case(bad)
