@@ -407,8 +407,9 @@ static void fz_set_pose(fz_in *in, fz_ctx *c)
     uint64_t fz_h_ = lc_world_state_hash(c->w);
     if (row >= 0 && lc_world_get_state(c->w, &v) == LC_OK) memcpy(old, &v.state[row * 6], sizeof old);
     /* The dynamics may take a body beyond what lc_body_set_pose accepts (|x|, |angle| <= 1e9: a 1e-300 kg
-     * body under a 1 N force is at 1e298 m after one step, finding 27); its pose could not be put back
-     * after a move into overlap, so it is not moved */
+     * body under a 1 N force is at 1e298 m after one step: corpus/step-regressions/
+     * harness-pose-beyond-1e9m-featherweight-pushed); its pose could not be put back after a move into
+     * overlap, so it is not moved */
     if (fabs(old[0]) > 1e9 || fabs(old[1]) > 1e9 || fabs(old[2]) > 1e9) return;
     if (FZ_CALL(c->w, lc_body_set_pose(c->w, id, p, a)) != LC_OK) return;
     if (fz_overlaps_any(c->w, id, NULL, NULL)) {

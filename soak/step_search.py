@@ -19,7 +19,7 @@ CI's 52 000 steps/s: a command every 1 300 steps, a parameter every 104 000, a r
   two halves go through.
 
 Prints a line per seed and the totals, and the largest work counters of one step
-(docs/hardening.md, "A failed soak in CI"). Exit status 1 when a step was undone.
+(docs/hardening.md, "The node when C undoes a step"). Exit status 1 when a step was undone.
 """
 from __future__ import annotations
 

@@ -4,8 +4,9 @@ A step is undone with LC_ERR_NUMERIC once its solves have visited more than LC_M
 (1e9, libcollide/src/tunables.h) matrix entries per body of the world (lc_counters.solver_work: m^2 per
 pivot or sweep of a dense solve of m rows, 12 m per product of a sparse one). This prints, per scene, the step
 with the most solver work per body, its CPU time, and the cap's margin over it: the cap must sit well
-above every legitimate scene, and far below what a pathological step does (fuzz finding 32, four
-coincident 5e-12 m decagons at 1e6 m/s: 1.7e10 per body at the 500 000-evaluation cap, 110 s).
+above every legitimate scene, and far below what a pathological step does (four coincident 5e-12 m
+decagons at 1e6 m/s, fuzz/corpus/step-regressions/slow-solver-work-coincident-tiny-decagons: 1.7e10
+per body at the 500 000-evaluation cap, 110 s).
 
     source scripts/env.sh && python bench/repro/solver_work_per_body.py [--quick]
 

@@ -80,11 +80,13 @@ static int push_touch(const lc_world *w, const double *state, frame fa, frame fb
     lc_touch *t = (lc_touch *)buf->p;
     lc_vec2 p = to_world(fa, w->shape[a].v[vertex]);
     /* A point already recorded for this pair at (nearly) the same place is the same contact. "Nearly"
-     * is max_gap, but never a quarter of either body's shortest edge, so two corners of one body are
-     * never one contact: with a contact_distance of 0.5 m (the API allows up to 1 m) the two corners
-     * of a 5 cm box's end were one, and the corner that sank into a wall was dropped for its
-     * neighbour above it (fuzz finding 25: 8.7e-7 m in; a quarter of the smaller body's radius was
-     * not enough for a 5 cm x 90 cm box, finding 34: 5 cm in). */
+     * is max_gap, but never more than a quarter of either body's shortest edge, so two corners of one
+     * body are never one contact. A contact_distance of 0.5 m (the API allows up to 1 m) would
+     * otherwise merge the two corners of a 5 cm box's end, and a corner sinking into a wall would be
+     * dropped for its neighbour on the surface, so the end-of-step projection never sees the overlap.
+     * A bound by the body's radius instead of its edge is not enough for a thin box (5 cm x 90 cm:
+     * a quarter of its radius is 11 cm). Regression inputs: fuzz/corpus/step-regressions/
+     * overlap-merged-corners-large-contact-distance, overlap-merged-corners-thin-box-contact-distance-0.5. */
     double merge = fmin(max_gap, 0.25 * fmin(w->shape[a].min_edge, w->shape[b].min_edge));
     int j;
     for (j = first_of_pair; j < count; ++j) {

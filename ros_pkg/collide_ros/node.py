@@ -63,7 +63,7 @@ SPLIT_DEPTH = 6
 # passes, 1e9 solver work per body): 2 + 2 + ... more attempts at that cost would stall the loop (and
 # the executor, which waits for the world lock) for many times as long. The soak's command mix on
 # four blocks took at most 3 660 evaluations, 1 100 serial passes and 1.2e5 solver work per body in
-# a step (soak/step_search.py, 2.5e8 steps; docs/hardening.md "A failed soak in CI").
+# a step (soak/step_search.py, 2.5e8 steps; docs/hardening.md "The node when C undoes a step").
 SPLIT_MAX_WORK = {"force_evaluations": 20_000, "serial_iterations": 5_000}
 SPLIT_MAX_SOLVER_WORK_PER_BODY = 1e7
 

@@ -555,7 +555,8 @@ static void test_infeasible(lc_lcp_workspace *ws)
     CHECK(r.status == 1, "infeasible: status %d", r.status);
     CHECK(r.fallback == 1 && r.sweeps == 50, "infeasible: fallback %d sweeps %d", r.fallback, r.sweeps);
     /* the work counted (lc_counters.solver_work) includes the fallback's sweeps, whichever answer is
-     * kept: fuzz finding 33 ran 27 s on solves whose counted work was the pivots alone */
+     * kept: counting the pivots alone, fuzz/corpus/step-regressions/
+     * slow-solver-work-fallback-sweeps-coincident-polygons ran 27 s within the solver-work cap */
     CHECK(lc_lcp_work(2, &r) == (uint64_t)(2 + r.pivots + 50) * 4u, "infeasible: work %llu for %d pivots and 50 sweeps",
           (unsigned long long)lc_lcp_work(2, &r), r.pivots);
     CHECK(isfinite(f[0]) && isfinite(f[1]) && f[0] >= 0.0 && f[1] >= 0.0, "infeasible: f = (%g, %g)", f[0], f[1]);

@@ -179,7 +179,7 @@ def test_counts_match_what_a_subscriber_received(sim: SimClient) -> None:
 def test_commands_dropped_while_the_executor_is_busy_are_counted_lost(sim: SimClient) -> None:
     """While one ~/step call keeps the node's executor busy, DDS keeps only the newest 10 (the
     command queue's depth) of a burst on one topic; the node counts the others as lost/<topic>
-    from the gap in the publisher's sequence numbers (docs/hardening.md, "Soak", finding 2)."""
+    from the gap in the publisher's sequence numbers (docs/ros_interface.md, "Message counts in /diagnostics")."""
     assert sim.wait_subscribed("thrusters", ThrusterCommand)
     echoes: list[ThrusterCommand] = []
     sub = sim.node.create_subscription(ThrusterCommand, "applied/thrusters", echoes.append, 100)
@@ -282,7 +282,7 @@ class _ContactsOnly:
 
 def test_contacts_beyond_the_cap_are_dropped_and_counted() -> None:
     # The cap bounds the contacts message, and with it what a reliable writer's history keeps
-    # (docs/hardening.md, "Soak", finding 3).
+    # (docs/hardening.md, "Soak").
     ctx, node, exc = _in_process_node(DEPTH)
     try:
         assert exc is None and node is not None

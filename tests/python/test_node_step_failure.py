@@ -7,7 +7,7 @@ time_step / 2**SPLIT_DEPTH fails does it drop the commands and springs made over
 is injected by wrapping the world's step where the node's bookkeeping is checked (time, parts,
 counts, commands, the warning); two tests use a real one, a block at ~1e5 m/s and 1e5 rad/s.
 (With the soak's legal values it is rare: none in 2.5e8 steps of its command mix, soak/step_search.py;
-docs/hardening.md "A failed soak in CI".)
+docs/hardening.md "The node when C undoes a step".)
 """
 from __future__ import annotations
 

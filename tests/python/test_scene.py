@@ -219,10 +219,11 @@ def test_hostile_yaml_recursive_and_exploding_aliases(tmp_path: Path, monkeypatc
         load_scene(write(tmp_path, "bodies: []\n\tworld: {}\n"))
 
 
-# ---- fuzzing findings (docs/hardening.md "Fuzzing", findings 7-9, 12, 13) ------------------------
+# ---- inputs the scene fuzzer found (fuzz/corpus/scene-regressions, docs/hardening.md "Fuzzing") ----
 
 def test_deep_nesting_is_refused_before_recursion(tmp_path: Path) -> None:
-    """Finding 7: thousands of levels raised RecursionError in json, PyYAML's composer or the reader."""
+    """Thousands of levels must not reach a RecursionError in json, PyYAML's composer or the reader
+    (scene-regressions/deep-*)."""
     limit = collide.scene._MAX_DEPTH
     cases = [
         ("seq.yaml", "[" * 5000 + "]" * 5000, "1: [0][0][0][0]...: nested more than"),
@@ -255,7 +256,8 @@ def test_deep_nesting_is_refused_before_recursion(tmp_path: Path) -> None:
 @pytest.mark.parametrize("entry,shown", [("-", "nothing (null)"), ("- 3", "int 3"), ("- [a]", "a list of 1"),
                                          ("- box", "str 'box'")])
 def test_body_entry_that_is_not_a_mapping_names_its_index(tmp_path: Path, entry: str, shown: str) -> None:
-    """Finding 8: a non-mapping `bodies` entry raised KeyError: 'None'."""
+    """A non-mapping `bodies` entry is named by its index, not a KeyError
+    (scene-regressions/*-body-entry)."""
     text = f"bodies:\n  - {{name: a, shape: box, width: 1, height: 1}}\n  {entry}\n"
     with pytest.raises(SceneError) as err:
         load_scene(write(tmp_path, text))
@@ -279,14 +281,16 @@ def test_body_entry_that_is_not_a_mapping_names_its_index(tmp_path: Path, entry:
     ("bodies: []\ndescription: !!timestamp never\n", "scene.yaml:2: description: cannot read 'never' as timestamp"),
 ])
 def test_unknown_or_unreadable_yaml_tags(tmp_path: Path, text: str, words: str) -> None:
-    """Finding 9: an unknown tag raised yaml.constructor.ConstructorError."""
+    """An unknown or unreadable tag is a SceneError, not a PyYAML error
+    (scene-regressions/unknown-yaml-tag*)."""
     with pytest.raises(SceneError) as err:
         load_scene(write(tmp_path, text))
     assert words in str(err.value), str(err.value)
 
 
 def test_scene_without_world_round_trips(tmp_path: Path) -> None:
-    """Finding 12: without a `world` key, load_scene(scene.to_dict()) was not equal to the scene."""
+    """Without a `world` key, load_scene(scene.to_dict()) equals the scene
+    (scene-regressions/no-world-key-round-trip)."""
     sc = load_scene(write(tmp_path, "bodies:\n  - {name: a, shape: box, width: 1, height: 1}\n"))
     assert sc.world == dict.fromkeys(sc.world) and "gravity" in sc.world  # every field present, unset
     again = load_scene(sc.to_dict())
@@ -299,7 +303,8 @@ def test_scene_without_world_round_trips(tmp_path: Path) -> None:
 @pytest.mark.parametrize("shape,shown", [("[box]", "a list of 1"), ("{box: 1}", "a mapping"), ("1", "int 1"),
                                          ("null", "nothing (null)")])
 def test_shape_that_is_not_a_string(tmp_path: Path, shape: str, shown: str) -> None:
-    """Finding 13: `shape: [box]` raised TypeError: unhashable type: 'list'."""
+    """`shape: [box]` is a SceneError, not TypeError: unhashable type: 'list'
+    (scene-regressions/list-shape)."""
     text = f"bodies:\n  - {{name: a, shape: {shape}, width: 1, height: 1}}\n"
     with pytest.raises(SceneError) as err:
         load_scene(write(tmp_path, text))
@@ -307,7 +312,7 @@ def test_shape_that_is_not_a_string(tmp_path: Path, shape: str, shown: str) -> N
 
 
 def test_integer_too_large_for_a_double(tmp_path: Path) -> None:
-    """Seen while fixing finding 9: float() of a 400-digit integer raised OverflowError."""
+    """A 400-digit integer is a SceneError, not float()'s OverflowError."""
     text = "bodies:\n  - {name: a, shape: box, width: 1, height: 1, mass: 1" + "0" * 400 + "}\n"
     with pytest.raises(SceneError, match=r"scene.yaml:2: bodies\[0\]\.mass: must be a finite number, "
                                          r"got an integer of 401 digits"):
