@@ -35,8 +35,9 @@
  * check is then coarser for that body). */
 #define LC_MAX_TRIALS 1024
 /* Most crossings one step may set aside as stalled (an impact at time 0 with nothing to do) before it
- * stops looking for crossings at all; the pass keeps them in a fixed array of this size (fuzz finding
- * 24: a sliver at 1e6 m/s with damping 1e9 stalled 65, docs/hardening.md). */
+ * stops looking for crossings at all; the pass keeps them in a fixed array of this size (a sliver at
+ * 1e6 m/s with damping 1e9 stalls 65; regression input
+ * fuzz/corpus/step-regressions/stalled-list-overflow-65-stalled-crossings). */
 #define LC_MAX_STALLED 64
 /* Sub-times at which the swept check samples a pair whose paths may stray from their chords (a vertex
  * dipping into another body and out again within the interval, invisible to the end-point test); each
