@@ -280,7 +280,10 @@ static int solve(island_ctx *c, lc_contact_row *rows, int m)
             w->last.contact_exact_solves++;
         memcpy(c->b.v, vstart, (size_t)c->b.n * 3 * sizeof(double));
     }
-    s = lc_contact_solver_run(rows, m, c->b.v, c->b.inv_mass, c->b.inv_inertia, sweeps, w->def.contact_tolerance);
+    /* a precise retry runs its sweeps out: a perturbed pyramid's solve crawls, below the stall rule's
+     * halving, to an answer whose energy the island can pay, where stopping left a gain */
+    s = lc_contact_solver_run(rows, m, c->b.v, c->b.inv_mass, c->b.inv_inertia, sweeps, w->def.contact_tolerance,
+                              c->precise ? 0 : LC_CONTACT_STALL_SWEEPS);
     count_solve(c, s, m);
     return 0;
 }
@@ -594,7 +597,7 @@ static int project(island_ctx *c, double *left)
         }
         memset(c->b.disp, 0, (size_t)c->b.n * 3 * sizeof(double));
         ps = lc_contact_solver_run(rows, nt, c->b.disp, c->b.inv_mass, c->b.inv_inertia, LC_CONTACT_PROJECTION_SWEEPS,
-                                   LC_CONTACT_PROJECTION_SLACK);
+                                   LC_CONTACT_PROJECTION_SLACK, LC_CONTACT_STALL_SWEEPS);
         /* a pass that cut the overlap a hundredfold is kept: the next pass starts from there */
         if (ps.residual > LC_CONTACT_PROJECTION_SLACK && ps.residual > LC_CONTACT_PROJECTION_GAIN * *left) {
             memset(c->b.disp, 0, (size_t)c->b.n * 3 * sizeof(double));

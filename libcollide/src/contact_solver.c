@@ -2,7 +2,6 @@
  * rule). */
 #include <math.h>
 #include "contact_solver.h"
-#include "tunables.h"
 
 static double row_mass(const lc_contact_row *r, double rla, double rlb, const double *inv_mass,
                        const double *inv_inertia)
@@ -207,7 +206,8 @@ static double sweep(lc_contact_row *rows, int nrows, double *v, const double *in
 }
 
 lc_contact_solve lc_contact_solver_run(lc_contact_row *rows, int nrows, double *v, const double *inv_mass,
-                                       const double *inv_inertia, int max_sweeps, double tolerance)
+                                       const double *inv_inertia, int max_sweeps, double tolerance,
+                                       int stall_sweeps)
 {
     lc_contact_solve out;
     double checkpoint = INFINITY, rr_old = 0.0;
@@ -236,7 +236,7 @@ lc_contact_solve lc_contact_solver_run(lc_contact_row *rows, int nrows, double *
     }
     for (s = 0; s < max_sweeps; ++s) {
         double change, rr = 0.0, beta;
-        if (s > 0 && s % LC_CONTACT_STALL_SWEEPS == 0) {
+        if (stall_sweeps > 0 && s > 0 && s % stall_sweeps == 0) {
             /* Gauss-Seidel on frictional rows can crawl at a ratio near 1 (two bodies whose points'
              * friction and normal impulses trade through their rotation): a solve whose largest
              * change has not halved in that many sweeps stops and reports it */

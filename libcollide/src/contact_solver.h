@@ -22,8 +22,8 @@
  * Stopping rule: a sweep whose largest change of any row, in velocity units (|d lambda| times the
  * row's inverse effective mass, m/s), is at most `tolerance` ends the solve: every row then met its
  * condition to `tolerance` when it was visited. Otherwise the solve ends after `max_sweeps` sweeps,
- * or when that largest change has not halved over LC_CONTACT_STALL_SWEEPS sweeps (the iteration
- * crawls), and reports it as its residual. A warm start (the impulses passed in) is applied
+ * or when that largest change has not halved over `stall_sweeps` sweeps (the iteration crawls; 0:
+ * never), and reports it as its residual. A warm start (the impulses passed in) is applied
  * to the velocities first; a quiescent, well warm-started problem ends after one sweep. */
 #ifndef LC_CONTACT_SOLVER_H
 #define LC_CONTACT_SOLVER_H
@@ -59,7 +59,8 @@ typedef struct lc_contact_solve {
 /* Solves the rows in place. v: nbodies x 3 velocities (changed in place: the answer's velocities);
  * inv_mass, inv_inertia: nbodies each. Rows with a non-finite warm start start from 0. */
 lc_contact_solve lc_contact_solver_run(lc_contact_row *rows, int nrows, double *v, const double *inv_mass,
-                                       const double *inv_inertia, int max_sweeps, double tolerance);
+                                       const double *inv_inertia, int max_sweeps, double tolerance,
+                                       int stall_sweeps);
 
 /* Adds the impulse dn along the row's normal and dt along its tangent to its two bodies' velocities v. */
 void lc_contact_row_apply(const lc_contact_row *r, double dn, double dt, double *v, const double *inv_mass,

@@ -129,7 +129,8 @@
  * hit by a box: seconds for one step), and the gain such a step keeps is what its stalled solve left,
  * ~1e-7 of the island's energy in that pyramid. */
 #define LC_CONTACT_EVENT_FALLBACK_BODIES 8
-/* Sweeps over which a contact solve's largest change must halve, or the solve stops as stalled. */
+/* Sweeps over which a contact solve's largest change must halve, or the solve stops as stalled (a
+ * precise retry runs its sweeps out). */
 #ifndef LC_CONTACT_STALL_SWEEPS   /* -D to measure */
 #define LC_CONTACT_STALL_SWEEPS 32
 #endif

@@ -74,7 +74,7 @@ static void ramp(double mu, int exact)
     if (exact) {
         CHECK(lc_contact_solve_exact(r, 2, v, im, ii, scratch) >= 0, "%s mu %.1f: pivoting ends", who, mu);
     } else {
-        lc_contact_solve s = lc_contact_solver_run(r, 2, v, im, ii, 10000, 1e-12);
+        lc_contact_solve s = lc_contact_solver_run(r, 2, v, im, ii, 10000, 1e-12, 32);
         CHECK(s.residual <= 1e-12, "%s mu %.1f: converges (%d sweeps, residual %.3g)", who, mu, s.sweeps,
               s.residual);
     }
@@ -112,7 +112,7 @@ static void two_blocks(void)
     /* the exact impulses as a warm start from the start velocities: one sweep changes them by no more
      * than their 1e-9 m/s */
     memcpy(again, r, sizeof r);
-    s = lc_contact_solver_run(again, 4, v1, im, ii, 100, 1e-9);
+    s = lc_contact_solver_run(again, 4, v1, im, ii, 100, 1e-9, 32);
     CHECK(s.sweeps == 1 && s.residual <= 1e-9, "the exact answer is the iteration's fixed point (%d sweeps, %.3g)",
           s.sweeps, s.residual);
 }
