@@ -722,6 +722,11 @@ class SimNode(Node):
             c, s = math.cos(angle), math.sin(angle)
             placed = verts @ np.array([[c, s], [-s, c]]) + np.array([p.x, p.y])
             lo, hi = placed.min(axis=0), placed.max(axis=0)
+            outside = self._outside_static_extent(lo, hi)
+            if outside:
+                resp.message = f"spawn '{name}' at ({p.x:g}, {p.y:g}) {outside}"
+                self._warn(f"spawn:outside:{name}", f"rejected: {resp.message}")
+                return resp
             for other, body in self._bodies.items():
                 ov = body.world_vertices()
                 if np.any(ov.max(axis=0) <= lo) or np.any(ov.min(axis=0) >= hi):
@@ -744,10 +749,31 @@ class SimNode(Node):
         resp.message = f"spawned '{name}'"
         return resp
 
+    def _outside_static_extent(self, lo: np.ndarray, hi: np.ndarray) -> str | None:
+        """Why a body with bounds [lo, hi] lies (partly) outside the box the static bodies enclose, or None.
+
+        The static bodies (walls, floor, fixed obstacles) bound the world; a body placed beyond them would
+        fall or fly away for ever. A world without static bodies has no such bound."""
+        extent = [self._bodies[n].world_vertices() for n in self._names if self._bodies[n].static]
+        if not extent:
+            return None
+        pts = np.vstack(extent)
+        smin, smax = pts.min(axis=0), pts.max(axis=0)
+        if np.all(lo >= smin) and np.all(hi <= smax):
+            return None
+        return (f"lies outside the box the static bodies enclose (x in [{smin[0]:g}, {smax[0]:g}], "
+                f"y in [{smin[1]:g}, {smax[1]:g}])")
+
     def _srv_kill(self, req: Kill.Request, resp: Kill.Response) -> Kill.Response:
         if req.name not in self._row_of:
             resp.success = False
             resp.message = f"no body named '{req.name}'"
+            return resp
+        if self._bodies[req.name].static and not self._p["allow_kill_static"]:
+            resp.success = False
+            resp.message = (f"'{req.name}' is static (a wall of the box or a fixed body) and stays; "
+                            "set parameter allow_kill_static to true to remove it")
+            self._warn(f"kill:static:{req.name}", f"rejected: {resp.message}")
             return resp
         self.world.remove_body(req.name)
         self._springs = {s: e for s, e in self._springs.items() if e.body != req.name}

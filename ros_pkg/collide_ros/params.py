@@ -53,6 +53,7 @@ SPECS: tuple[Spec, ...] = (
     Spec("max_body_topics", 64, "Bodies (in row order) that get a <body>/thrust subscription", 0, 100000,
          read_only=True),
     Spec("start_paused", False, "Start paused (use ~/step or ~/pause)", read_only=True),
+    Spec("allow_kill_static", False, "~/kill may remove static bodies (the walls of the box); false keeps them"),
 )
 
 BY_NAME = {s.name: s for s in SPECS}

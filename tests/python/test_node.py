@@ -284,6 +284,27 @@ def test_spawn_rejects_bad_shapes_and_overlap(sim: SimClient) -> None:
     assert list(sim.fresh("bodies/states").names) == ["block1", "block2"]
 
 
+def test_walls_stay_and_spawn_stays_inside_the_box(sim: SimClient) -> None:
+    wall = sim.call(Kill, "kill", Kill.Request(name="wall_left"))
+    assert not wall.success and "static" in wall.message and "allow_kill_static" in wall.message
+    far = Spawn.Request(name="far", width=1.0, height=1.0, mass=1.0, elasticity=1.0)
+    far.pose.position.x, far.pose.position.y = 100.0, 100.0
+    r = sim.call(Spawn, "spawn", far)
+    assert not r.success and "outside the box the static bodies enclose" in r.message, r.message
+    names_now = list(sim.fresh("bodies/states").names)
+    assert names_now == ["block1", "block2"]
+    try:
+        assert sim.set_params({"allow_kill_static": True})[0].successful
+        assert sim.call(Kill, "kill", Kill.Request(name="wall_left")).success  # asked for explicitly
+        gone = sim.call(Kill, "kill", Kill.Request(name="wall_left"))
+        assert not gone.success and "no body named" in gone.message
+    finally:
+        assert sim.set_params({"allow_kill_static": False})[0].successful
+        assert sim.call(Empty, "reset") is not None  # the scene, walls included, comes back
+    back = sim.call(Kill, "kill", Kill.Request(name="wall_left"))
+    assert not back.success and "static" in back.message, back.message
+
+
 def test_spring_pulls_and_releases(sim: SimClient) -> None:
     assert sim.wait_subscribed("spring", SpringCommand)
     cmd = SpringCommand(name="mouse", body="block2", body_point=Point(x=0.0, y=1.0), target=Point(x=2.5, y=4.0),
