@@ -8,6 +8,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include "collide/version.h"
 #include "world.h"
 #include "sleep.h"
 #include "islands.h"
@@ -68,7 +69,7 @@ const char *lc_status_string(lc_status status)
     return "unknown status";
 }
 
-const char *lc_version(void) { return "0.1.0"; }
+const char *lc_version(void) { return LC_VERSION_STRING; }
 
 /* ---- defaults ------------------------------------------------------------------------------ */
 

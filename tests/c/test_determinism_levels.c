@@ -12,7 +12,9 @@
  *         --print        print "<step> <hash as 16 hex digits>" per step (a worker; also used by
  *                        tests/python/test_determinism_c_python.py);
  *         --script       print SCRIPT, which that Python test runs through `collide`.
- * The source tree is found from __FILE__ (CMake passes absolute paths) or $LIBCOLLIDE_SOURCE_DIR. */
+ * The source tree is found from __FILE__ (CMake passes absolute paths) or $LIBCOLLIDE_SOURCE_DIR;
+ * the build tree's generated headers (collide/version.h, which world.c includes) from
+ * LC_GENERATED_INCLUDE_DIR, which tests/c/CMakeLists.txt defines. */
 #define _POSIX_C_SOURCE 200809L
 #include <stdio.h>
 #include <stdlib.h>
@@ -46,6 +48,10 @@ static const char SCRIPT[] =
     "mask 0 0\n"
     "simultaneous\n"                               /* impact_mode = LC_IMPACT_SIMULTANEOUS */
     "step 100 0.005\n";
+
+#ifndef LC_GENERATED_INCLUDE_DIR
+#define LC_GENERATED_INCLUDE_DIR "" /* e.g. the worker of tests/python/test_determinism_c_python.py */
+#endif
 
 #define MAX_HASHES 1024
 #define MAX_ITEMS 32
@@ -218,10 +224,11 @@ static void check_level(const char *root, const char *level, const run_result *r
     CHECK(len > 0 && (size_t)len < sizeof exe, "%s", "executable name too long");
     len = snprintf(out, sizeof out, "./determinism_levels%s.out", level);
     CHECK(len > 0 && (size_t)len < sizeof out, "%s", "output name too long");
+    CHECK(LC_GENERATED_INCLUDE_DIR[0] != '\0', "%s", "built without LC_GENERATED_INCLUDE_DIR (collide/version.h)");
     len = snprintf(cmd, sizeof cmd,
-             "%s -std=c99 %s -ffp-contract=off -I'%slibcollide/include' -I'%slibcollide/src' -I'%stests/c' "
+             "%s -std=c99 %s -ffp-contract=off -I'%slibcollide/include' -I'%s' -I'%slibcollide/src' -I'%stests/c' "
              "'%slibcollide/src/'*.c '%stests/c/test_determinism_levels.c' -lm -o '%s' && '%s' --print > '%s'",
-             cc && cc[0] ? cc : "cc", level, root, root, root, root, root, exe, exe, out);
+             cc && cc[0] ? cc : "cc", level, root, LC_GENERATED_INCLUDE_DIR, root, root, root, root, exe, exe, out);
     CHECK(len > 0 && (size_t)len < sizeof cmd, "%s", "compile command too long (source path?)");
     if (check_failures() > 0) return;
     rc = system(cmd);

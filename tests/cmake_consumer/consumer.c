@@ -1,6 +1,9 @@
-/* Drops a block on the floor through the installed library and checks it bounced (exit 0 on success). */
+/* Drops a block on the floor through the installed library and checks it bounced, and that the
+ * installed generated collide/version.h names the library's version (exit 0 on success). */
 #include <stdio.h>
+#include <string.h>
 #include "collide/collide.h"
+#include "collide/version.h"
 
 int main(void)
 {
@@ -11,6 +14,10 @@ int main(void)
     lc_body_id id;
     lc_state_view s;
     int i;
+    if (strcmp(lc_version(), LC_VERSION_STRING) != 0) {
+        printf("lc_version() %s != LC_VERSION_STRING %s\n", lc_version(), LC_VERSION_STRING);
+        return 1;
+    }
     if (w == NULL) return 1;
     lc_make_rectangle(1.0, 1.0, v);
     b.vertices = v;

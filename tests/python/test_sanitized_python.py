@@ -24,6 +24,8 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
 SAN_DIR = ROOT / "build" / "sanitizer-python"
+# the generated collide/version.h (world.c includes it) of the CMake build the binding uses
+GENERATED_INCLUDE = Path(os.environ.get("LIBCOLLIDE_BUILD_DIR") or ROOT / "build") / "include"
 SAN_FLAGS = ["-std=c99", "-O1", "-g", "-fPIC", "-ffp-contract=off", "-fno-omit-frame-pointer",
              "-fsanitize=address,undefined", "-fno-sanitize-recover=all"]
 # the tests run under the sanitizers: the binding's own suites and two node tests (spawn errors go
@@ -41,7 +43,10 @@ def _gcc_file(name: str) -> str:
 
 
 def _sources() -> list[Path]:
-    return sorted((ROOT / "libcollide" / "src").glob("*.[ch]")) + sorted((ROOT / "libcollide" / "include").rglob("*.h"))
+    version_h = GENERATED_INCLUDE / "collide" / "version.h"
+    assert version_h.exists(), f"{version_h} not found: configure the C build first (scripts/setup)"
+    return (sorted((ROOT / "libcollide" / "src").glob("*.[ch]")) + sorted((ROOT / "libcollide" / "include").rglob("*.h"))
+            + [version_h])
 
 
 @pytest.fixture(scope="module")
@@ -60,7 +65,7 @@ def sanitized_lib() -> Path:
         if not lib.exists() or not stamp_file.exists() or stamp_file.read_text() != stamp:
             tmp = SAN_DIR / "libcollide.so.0.tmp"
             cmd = (["nice", "gcc", *SAN_FLAGS, "-shared", "-Wl,-soname,libcollide.so.0",
-                    f"-I{ROOT / 'libcollide' / 'include'}", f"-I{ROOT / 'libcollide' / 'src'}"]
+                    f"-I{ROOT / 'libcollide' / 'include'}", f"-I{GENERATED_INCLUDE}", f"-I{ROOT / 'libcollide' / 'src'}"]
                    + [str(p) for p in sorted((ROOT / "libcollide" / "src").glob("*.c"))] + ["-lm", "-o", str(tmp)])
             res = subprocess.run(cmd, capture_output=True, text=True)
             assert res.returncode == 0, f"sanitizer build failed:\n{res.stderr[-4000:]}"
