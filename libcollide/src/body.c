@@ -1,6 +1,7 @@
 /* Bodies: their rows and ids, adding them (one polygon, or the four walls of a box) and removing them,
- * reading and setting their states, poses, velocities, masses, materials and external forces, and
- * reading their vertices. A body is a row of the world's arrays, one array a field, in insertion order. */
+ * reading and setting their states, poses, velocities, masses, inertias, materials and external forces,
+ * and reading their vertices and centres of mass. A body is a row of the world's arrays, one array a
+ * field, in insertion order. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -14,6 +15,30 @@ int lc_world_body_index(const lc_world *w, lc_body_id id)
 }
 
 int lc_world_body_count(const lc_world *w) { return w ? w->count : 0; }
+
+lc_status lc_read_row(const lc_world *w, lc_body_id id, int outputs_ok, const char *what, int *row)
+{
+    if (w == NULL) return LC_ERR_NULL;
+    if (!outputs_ok) return lc_fail((lc_world *)w, LC_ERR_NULL, "%s is NULL", what);
+    *row = lc_world_body_index(w, id);
+    if (*row < 0) return lc_fail((lc_world *)w, LC_ERR_UNKNOWN_BODY, "no body with id %u", (unsigned)id);
+    return LC_OK;
+}
+
+/* A given inertia (kg*m^2) of a dynamic body of `mass` whose farthest vertex is `radius` from its centre
+ * of mass: finite, > 0, its inverse finite, and at most mass * radius^2, the most any mass inside the
+ * polygon can have. */
+static lc_status check_inertia(lc_world *w, double inertia, double mass, double radius)
+{
+    double most = mass * radius * radius;
+    LC_CHECK_FINITE(w, inertia, "inertia");
+    if (!(inertia > 0.0) || !isfinite(1.0 / inertia))
+        return lc_fail(w, LC_ERR_OUT_OF_RANGE, "inertia = %g kg*m^2 must be > 0 (0 in a body def: the polygon's)", inertia);
+    if (inertia > most)
+        return lc_fail(w, LC_ERR_OUT_OF_RANGE, "inertia = %g kg*m^2 exceeds mass * r^2 = %g (r = %g m, the farthest vertex "
+                       "from the centre of mass): no mass inside the polygon has that much", inertia, most, radius);
+    return LC_OK;
+}
 
 #define GROW(ptr, n) do { void *p_ = realloc((ptr), (size_t)(n) * sizeof *(ptr)); if (!p_) return 0; (ptr) = p_; } while (0)
 
@@ -72,8 +97,15 @@ lc_status lc_world_add_body(lc_world *w, const lc_body_def *d, lc_body_id *out_i
     }
     LC_CHECK_RANGE(w, d->elasticity, 0.0, 1.0, "elasticity");
     LC_CHECK_RANGE(w, d->friction, 0.0, 10.0, "friction");
-    s = lc_shape_build(&shape, d->vertices, d->vertex_count, why, sizeof why);
+    if (d->custom_center_of_mass != 0 && d->custom_center_of_mass != 1)
+        return lc_fail(w, LC_ERR_OUT_OF_RANGE, "custom_center_of_mass = %d is 0 (the centroid) or 1", d->custom_center_of_mass);
+    s = lc_shape_build(&shape, d->vertices, d->vertex_count, d->custom_center_of_mass ? &d->center_of_mass : NULL,
+                       why, sizeof why);
     if (s != LC_OK) return lc_fail(w, s, "%s", why);
+    if (d->type == LC_BODY_DYNAMIC && d->inertia != 0.0) {
+        LC_TRY(check_inertia(w, d->inertia, d->mass, shape.radius));
+        shape.inertia_per_mass = d->inertia / d->mass;
+    }
     if (w->next_body_id == LC_WORLD_ANCHOR) return lc_fail(w, LC_ERR_OUT_OF_RANGE, "body ids exhausted");
     if (!reserve_bodies(w, w->count + 1) || !reserve_id(w, w->next_body_id))
         return lc_fail(w, LC_ERR_NO_MEMORY, "out of memory adding a body");
@@ -103,7 +135,7 @@ lc_status lc_world_add_body(lc_world *w, const lc_body_def *d, lc_body_id *out_i
         w->state[row * 6 + SVY] = d->velocity.y;
         w->state[row * 6 + SW] = d->angular_velocity;
         w->mass[row] = d->mass;
-        w->inertia[row] = d->mass * shape.unit_inertia;
+        w->inertia[row] = d->inertia != 0.0 ? d->inertia : d->mass * shape.unit_inertia;
         w->inv_mass[row] = 1.0 / d->mass;
         w->inv_inertia[row] = 1.0 / w->inertia[row];
     }
@@ -262,11 +294,44 @@ lc_status lc_body_set_mass(lc_world *w, lc_body_id id, double mass)
     LC_CHECK_FINITE(w, mass, "mass");
     if (!(mass > 0.0) || mass > 1e12) return lc_fail(w, LC_ERR_OUT_OF_RANGE, "mass = %g must be in (0, 1e12] kg", mass);
     w->mass[row] = mass;
-    w->inertia[row] = mass * w->shape[row].unit_inertia;
+    w->inertia[row] = mass * w->shape[row].inertia_per_mass;
     w->inv_mass[row] = 1.0 / mass;
     w->inv_inertia[row] = 1.0 / w->inertia[row];
     w->edits++;
     return lc_changed(w);
+}
+
+/* The body's inertia (which = 1) or mass (which = 0): the readers of lc_body_get_mass and _inertia. */
+static lc_status read_mass_or_inertia(const lc_world *w, lc_body_id id, int which, double *out)
+{
+    int row = -1;
+    LC_TRY(lc_read_row(w, id, out != NULL, "out", &row));
+    *out = which ? w->inertia[row] : w->mass[row];
+    return LC_OK;
+}
+
+lc_status lc_body_get_mass(const lc_world *w, lc_body_id id, double *out)
+{
+    return read_mass_or_inertia(w, id, 0, out);
+}
+
+lc_status lc_body_set_inertia(lc_world *w, lc_body_id id, double inertia)
+{
+    int row;
+    lc_shape *sh;
+    LC_GET_DYNAMIC_ROW(w, id, row);
+    sh = &w->shape[row];
+    if (inertia != 0.0) LC_TRY(check_inertia(w, inertia, w->mass[row], sh->radius));
+    sh->inertia_per_mass = inertia != 0.0 ? inertia / w->mass[row] : sh->unit_inertia;
+    w->inertia[row] = inertia != 0.0 ? inertia : w->mass[row] * sh->unit_inertia;
+    w->inv_inertia[row] = 1.0 / w->inertia[row];
+    w->edits++;
+    return lc_changed(w);
+}
+
+lc_status lc_body_get_inertia(const lc_world *w, lc_body_id id, double *out)
+{
+    return read_mass_or_inertia(w, id, 1, out);
 }
 
 lc_status lc_body_set_material(lc_world *w, lc_body_id id, double e, double mu)
@@ -281,6 +346,15 @@ lc_status lc_body_set_material(lc_world *w, lc_body_id id, double e, double mu)
     return lc_changed(w);
 }
 
+lc_status lc_body_get_material(const lc_world *w, lc_body_id id, double *e, double *mu)
+{
+    int row = -1;
+    LC_TRY(lc_read_row(w, id, e != NULL && mu != NULL, "elasticity or friction output", &row));
+    *e = w->elasticity[row];
+    *mu = w->friction[row];
+    return LC_OK;
+}
+
 lc_status lc_body_set_external(lc_world *w, lc_body_id id, lc_vec2 force, double torque)
 {
     int row;
@@ -292,6 +366,15 @@ lc_status lc_body_set_external(lc_world *w, lc_body_id id, lc_vec2 force, double
     return lc_changed(w);
 }
 
+lc_status lc_body_get_external(const lc_world *w, lc_body_id id, lc_vec2 *force, double *torque)
+{
+    int row = -1;
+    LC_TRY(lc_read_row(w, id, force != NULL && torque != NULL, "force or torque output", &row));
+    *force = w->ext_force[row];
+    *torque = w->ext_torque[row];
+    return LC_OK;
+}
+
 int lc_body_vertex_count(const lc_world *w, lc_body_id id)
 {
     int row = lc_world_body_index(w, id);
@@ -300,10 +383,8 @@ int lc_body_vertex_count(const lc_world *w, lc_body_id id)
 
 lc_status lc_body_get_local_vertices(const lc_world *w, lc_body_id id, lc_vec2 *out, int capacity)
 {
-    int row = lc_world_body_index(w, id), i;
-    if (w == NULL) return LC_ERR_NULL;
-    if (out == NULL) return lc_fail((lc_world *)w, LC_ERR_NULL, "out is NULL");
-    if (row < 0) return lc_fail((lc_world *)w, LC_ERR_UNKNOWN_BODY, "no body with id %u", (unsigned)id);
+    int row = -1, i;
+    LC_TRY(lc_read_row(w, id, out != NULL, "out", &row));
     if (capacity < w->shape[row].count)
         return lc_fail((lc_world *)w, LC_ERR_OUT_OF_RANGE, "capacity %d is below the body's %d vertices", capacity, w->shape[row].count);
     for (i = 0; i < w->shape[row].count; ++i) out[i] = w->shape[row].v[i];
@@ -312,12 +393,10 @@ lc_status lc_body_get_local_vertices(const lc_world *w, lc_body_id id, lc_vec2 *
 
 lc_status lc_body_get_world_vertices(const lc_world *w, lc_body_id id, lc_vec2 *out, int capacity)
 {
-    int row = lc_world_body_index(w, id), i;
+    int row = -1, i;
     double c, s;
     const double *st;
-    if (w == NULL) return LC_ERR_NULL;
-    if (out == NULL) return lc_fail((lc_world *)w, LC_ERR_NULL, "out is NULL");
-    if (row < 0) return lc_fail((lc_world *)w, LC_ERR_UNKNOWN_BODY, "no body with id %u", (unsigned)id);
+    LC_TRY(lc_read_row(w, id, out != NULL, "out", &row));
     if (capacity < w->shape[row].count)
         return lc_fail((lc_world *)w, LC_ERR_OUT_OF_RANGE, "capacity %d is below the body's %d vertices", capacity, w->shape[row].count);
     st = &w->state[row * 6];
@@ -330,10 +409,8 @@ lc_status lc_body_get_world_vertices(const lc_world *w, lc_body_id id, lc_vec2 *
 
 lc_status lc_body_get_center_offset(const lc_world *w, lc_body_id id, lc_vec2 *out)
 {
-    int row = lc_world_body_index(w, id);
-    if (w == NULL) return LC_ERR_NULL;
-    if (out == NULL) return lc_fail((lc_world *)w, LC_ERR_NULL, "out is NULL");
-    if (row < 0) return lc_fail((lc_world *)w, LC_ERR_UNKNOWN_BODY, "no body with id %u", (unsigned)id);
+    int row = -1;
+    LC_TRY(lc_read_row(w, id, out != NULL, "out", &row));
     *out = w->shape[row].center_offset;
     return LC_OK;
 }

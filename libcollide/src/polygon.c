@@ -1,4 +1,5 @@
-/* Convex polygons: validation and mass properties computed from the area (uniform density). */
+/* Convex polygons: validation and mass properties computed from the area (uniform density), about the
+ * centroid or about a given centre of mass. */
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
@@ -6,10 +7,10 @@
 
 static const double LC_PI = 3.14159265358979323846;
 
-lc_status lc_shape_build(lc_shape *out, const lc_vec2 *v, int count, char *why, size_t why_len)
+lc_status lc_shape_build(lc_shape *out, const lc_vec2 *v, int count, const lc_vec2 *center, char *why, size_t why_len)
 {
     lc_vec2 p[LC_MAX_POLYGON_VERTICES];
-    double area2 = 0.0, cx = 0.0, cy = 0.0, scale = 0.0, j = 0.0;
+    double area2 = 0.0, cx = 0.0, cy = 0.0, scale = 0.0, j = 0.0, ox, oy;
     int i, sign = 0;
     if (v == NULL) {
         snprintf(why, why_len, "vertices is NULL");
@@ -83,11 +84,32 @@ lc_status lc_shape_build(lc_shape *out, const lc_vec2 *v, int count, char *why, 
     }
     cx /= 3.0 * area2;
     cy /= 3.0 * area2;
+    ox = cx;
+    oy = cy;
+    if (center != NULL) {
+        /* A given centre of mass: the body's mass lies in its (convex) polygon, so its centre does too;
+         * points on the boundary are accepted to a rounding of the polygon's size. */
+        if (!isfinite(center->x) || !isfinite(center->y)) {
+            snprintf(why, why_len, "center_of_mass is not finite (%g, %g)", center->x, center->y);
+            return LC_ERR_NOT_FINITE;
+        }
+        for (i = 0; i < count; ++i) {
+            lc_vec2 e = lc_sub(p[(i + 1) % count], p[i]);
+            double inside = lc_cross(e, lc_sub(*center, p[i])) / sqrt(lc_dot(e, e));
+            if (inside < -1e-12 * scale) {
+                snprintf(why, why_len, "center_of_mass (%g, %g) is outside the polygon (%.3g m beyond its edge %d); "
+                         "a body's mass lies inside its polygon", center->x, center->y, -inside, i);
+                return LC_ERR_OUT_OF_RANGE;
+            }
+        }
+        ox = center->x;
+        oy = center->y;
+    }
     memset(out, 0, sizeof *out);
     out->count = count;
-    out->center_offset = lc_v(cx, cy);
+    out->center_offset = lc_v(ox, oy);
     out->area = area2 / 2.0;
-    for (i = 0; i < count; ++i) out->v[i] = lc_v(p[i].x - cx, p[i].y - cy);
+    for (i = 0; i < count; ++i) out->v[i] = lc_v(p[i].x - ox, p[i].y - oy);
     out->min_edge = HUGE_VAL;
     for (i = 0; i < count; ++i) {
         lc_vec2 a = out->v[i], b = out->v[(i + 1) % count];
@@ -95,12 +117,13 @@ lc_status lc_shape_build(lc_shape *out, const lc_vec2 *v, int count, char *why, 
         double len = sqrt(lc_dot(e, e));
         double c = lc_cross(a, b);
         out->n[i] = lc_v(e.y / len, -e.x / len);
-        /* second moment of the triangle (0, a, b) about the centroid-origin, per unit area */
+        /* second moment of the triangle (0, a, b) about the centre of mass, the origin, per unit area */
         j += c * (lc_dot(a, a) + lc_dot(a, b) + lc_dot(b, b));
         out->radius = fmax(out->radius, sqrt(lc_dot(a, a)));
         out->min_edge = fmin(out->min_edge, len);
     }
     out->unit_inertia = (j / 12.0) / out->area;
+    out->inertia_per_mass = out->unit_inertia;
     (void)sign;
     return LC_OK;
 }

@@ -21,3 +21,11 @@ lc_status lc_world_set_stage_timing(lc_world *w, int on)
     w->error[0] = '\0';
     return LC_OK;
 }
+
+lc_status lc_world_get_stage_timing(const lc_world *w, int *out)
+{
+    if (w == NULL) return LC_ERR_NULL;
+    if (out == NULL) return lc_fail((lc_world *)w, LC_ERR_NULL, "out is NULL");
+    *out = w->stage_timing;
+    return LC_OK;
+}

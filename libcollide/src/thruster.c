@@ -1,5 +1,5 @@
-/* Thrusters: adding them to a dynamic body (one, or the seed's four keyboard thrusters), setting their
- * levels and counting them. forces.c turns them into forces. */
+/* Thrusters: adding them to a dynamic body (one, or the seed's four keyboard thrusters), setting and
+ * reading their levels and counting them. forces.c turns them into forces. */
 #include <math.h>
 #include "world.h"
 
@@ -76,6 +76,27 @@ lc_status lc_body_set_thruster_mask(lc_world *w, lc_body_id id, uint32_t mask)
         return lc_fail(w, LC_ERR_UNKNOWN_THRUSTER, "mask 0x%x names thrusters body %u does not have (it has %d)", (unsigned)mask, (unsigned)id, w->thruster_count[row]);
     for (i = 0; i < w->thruster_count[row]; ++i) w->thrusters[row][i].level = (mask >> i) & 1u ? 1.0 : 0.0;
     return lc_changed(w);
+}
+
+lc_status lc_body_get_thruster_level(const lc_world *w, lc_body_id id, int index, double *out)
+{
+    int row = -1;
+    LC_TRY(lc_read_row(w, id, out != NULL, "out", &row));
+    if (index < 0 || index >= w->thruster_count[row])
+        return lc_fail((lc_world *)w, LC_ERR_UNKNOWN_THRUSTER, "body %u has no thruster %d (it has %d)", (unsigned)id, index, w->thruster_count[row]);
+    *out = w->thrusters[row][index].level;
+    return LC_OK;
+}
+
+lc_status lc_body_get_thruster_mask(const lc_world *w, lc_body_id id, uint32_t *out)
+{
+    int row, i;
+    uint32_t mask = 0;
+    LC_TRY(lc_read_row(w, id, out != NULL, "out", &row));
+    for (i = 0; i < w->thruster_count[row]; ++i)
+        if (w->thrusters[row][i].level > 0.0) mask |= (uint32_t)1u << i;
+    *out = mask;
+    return LC_OK;
 }
 
 int lc_body_thruster_count(const lc_world *w, lc_body_id id)

@@ -27,7 +27,10 @@ typedef struct lc_shape {
     double radius;                        /* max |v[i]| */
     double min_edge;                      /* length of the shortest edge */
     double area;
-    double unit_inertia;                  /* moment about the centre of mass per unit mass, m^2 */
+    double unit_inertia;                  /* the polygon's (uniform density) moment about the centre of mass
+                                             per unit mass, m^2 */
+    double inertia_per_mass;              /* the body's inertia over its mass, m^2: unit_inertia, or a given
+                                             inertia's (lc_body_set_mass keeps it) */
 } lc_shape;
 
 typedef struct lc_spring_rec {
@@ -154,6 +157,10 @@ lc_status lc_fail(lc_world *w, lc_status s, const char *fmt, ...);
          if ((row) < 0) return lc_fail((w), LC_ERR_UNKNOWN_BODY, "no body with id %u", (unsigned)(id)); } while (0)
 #define LC_GET_DYNAMIC_ROW(w, id, row) \
     do { LC_GET_ROW(w, id, row); if ((w)->is_static[row]) return lc_fail((w), LC_ERR_STATIC_BODY, "body %u is static", (unsigned)(id)); } while (0)
+/* row = the row of body `id` for a reader on a const world: LC_ERR_NULL for a NULL world, or for a NULL
+ * output (outputs_ok == 0; the message names `what`), LC_ERR_UNKNOWN_BODY; like any failed call, a
+ * failure records its message for lc_world_last_error (body.c). */
+lc_status lc_read_row(const lc_world *w, lc_body_id id, int outputs_ok, const char *what, int *row);
 /* Returns expr's status from the calling function unless it is LC_OK. */
 #define LC_TRY(expr) do { lc_status s_ = (expr); if (s_ != LC_OK) return s_; } while (0)
 /* LC_CHECK_RANGE of both components of v over [-limit, limit], named "<name>.x" and "<name>.y". */
@@ -172,7 +179,9 @@ static inline lc_status lc_changed(lc_world *w)
 void lc_remove_springs_of(lc_world *w, lc_body_id id);
 
 /* ---- polygon.c ---- */
-lc_status lc_shape_build(lc_shape *out, const lc_vec2 *v, int count, char *why, size_t why_len);
+/* Validates a polygon and builds its shape about `center` (local frame; NULL: the centroid), which must
+ * lie in the polygon. On failure returns the status and writes the reason into why. */
+lc_status lc_shape_build(lc_shape *out, const lc_vec2 *v, int count, const lc_vec2 *center, char *why, size_t why_len);
 
 /* ---- small vector helpers ---- */
 static inline lc_vec2 lc_v(double x, double y) { lc_vec2 r; r.x = x; r.y = y; return r; }

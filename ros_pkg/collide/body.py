@@ -19,13 +19,12 @@ def _vec(v: Any) -> tuple[float, float]:
 
 
 class _Record:
-    """What Python keeps about a body that C has no getter for."""
+    """What Python keeps about a body that C does not: its name. Everything else is read from C."""
 
-    __slots__ = ("name", "elasticity", "friction", "levels")
+    __slots__ = ("name",)
 
-    def __init__(self, name: str, elasticity: float, friction: float) -> None:
-        self.name, self.elasticity, self.friction = name, elasticity, friction
-        self.levels: list[float] = []
+    def __init__(self, name: str) -> None:
+        self.name = name
 
 
 BodyRef = Union["Body", str, int]  # a Body, its name or its id
@@ -90,9 +89,15 @@ class Body:
     def angular_velocity(self) -> float:
         return float(self._row()[5])
 
+    def _read(self, fn: Any) -> float:
+        out = ffi.new("double *")
+        check(self._w, fn(self._w, self.id, out))
+        return float(out[0])
+
     @property
     def mass(self) -> float:
-        return float(self._world.masses[self.index])
+        """kg (0 for a static body); setting it keeps the inertia per unit mass."""
+        return self._read(lib.lc_body_get_mass)
 
     @mass.setter
     def mass(self, value: float) -> None:
@@ -100,30 +105,39 @@ class Body:
 
     @property
     def inertia(self) -> float:
-        return float(self._world.inertias[self.index])
+        """kg*m^2 about the centre of mass (0 for a static body); set it in (0, mass * r^2], r the farthest
+        vertex from the centre of mass, or to 0 for the polygon's (uniform density)."""
+        return self._read(lib.lc_body_get_inertia)
+
+    @inertia.setter
+    def inertia(self, value: float) -> None:
+        check(self._w, lib.lc_body_set_inertia(self._w, self.id, cv.real(value, "inertia")))
 
     @property
     def static(self) -> bool:
         return bool(self._world.static_mask[self.index])
 
     @property
+    def material(self) -> tuple[float, float]:
+        """(elasticity, friction)."""
+        e, f = ffi.new("double *"), ffi.new("double *")
+        check(self._w, lib.lc_body_get_material(self._w, self.id, e, f))
+        return float(e[0]), float(f[0])
+
+    @property
     def elasticity(self) -> float:
-        self.index
-        return self._world._rec[self.id].elasticity
+        return self.material[0]
 
     @property
     def friction(self) -> float:
-        self.index
-        return self._world._rec[self.id].friction
+        return self.material[1]
 
     def set_material(self, elasticity: float | None = None, friction: float | None = None) -> None:
         """Set elasticity [0, 1] and/or friction [0, 10]; None keeps the current value."""
-        self.index  # raises if removed
-        rec = self._world._rec[self.id]
-        e = rec.elasticity if elasticity is None else cv.real(elasticity, "elasticity")
-        f = rec.friction if friction is None else cv.real(friction, "friction")
+        e0, f0 = self.material
+        e = e0 if elasticity is None else cv.real(elasticity, "elasticity")
+        f = f0 if friction is None else cv.real(friction, "friction")
         check(self._w, lib.lc_body_set_material(self._w, self.id, e, f))
-        rec.elasticity, rec.friction = e, f
 
     def set_pose(self, position: Any, angle: float) -> None:
         """Set the centre-of-mass position (m) and angle (rad)."""
@@ -139,6 +153,13 @@ class Body:
         """Constant external force (N, world frame, at the centre of mass) and torque (N*m)."""
         fx, fy = cv.vec2(force, "force")
         check(self._w, lib.lc_body_set_external(self._w, self.id, (fx, fy), cv.real(torque, "torque")))
+
+    @property
+    def external(self) -> tuple[tuple[float, float], float]:
+        """(force (N, world frame), torque (N*m)) set by set_external."""
+        f, t = ffi.new("lc_vec2 *"), ffi.new("double *")
+        check(self._w, lib.lc_body_get_external(self._w, self.id, f, t))
+        return _vec(f), float(t[0])
 
     def _vertices(self, fn: Any) -> np.ndarray:
         n = lib.lc_body_vertex_count(self._w, self.id)
@@ -163,6 +184,12 @@ class Body:
         check(self._w, lib.lc_body_get_center_offset(self._w, self.id, out))
         return _vec(out)
 
+    @property
+    def center_of_mass(self) -> tuple[float, float]:
+        """The centre of mass in the body's local frame (m): the given one, or the polygon's centroid.
+        The same point as center_offset."""
+        return self.center_offset
+
     # ---- thrusters ----
     def add_thruster(self, point: Any, direction: Any, magnitude: float) -> "Thruster":
         d = ffi.new("lc_thruster_def *")
@@ -171,14 +198,12 @@ class Body:
         d.magnitude = cv.real(magnitude, "magnitude")
         idx = ffi.new("int *")
         check(self._w, lib.lc_body_add_thruster(self._w, self.id, d, idx))
-        self._world._rec[self.id].levels.append(0.0)
         return Thruster(self, int(idx[0]))
 
     def add_default_thrusters(self, thrust: float = 1.5) -> list["Thruster"]:
         """The seed's four: 0 left, 1 right, 2 up, 3 down (keys S,F,E,D / J,L,I,K)."""
         first = ffi.new("int *")
         check(self._w, lib.lc_body_add_default_thrusters(self._w, self.id, cv.real(thrust, "thrust"), first))
-        self._world._rec[self.id].levels.extend([0.0] * 4)
         return [Thruster(self, int(first[0]) + i) for i in range(4)]
 
     @property
@@ -193,8 +218,13 @@ class Body:
         if not 0 <= m < 2**32:
             raise ValueError(f"mask must fit 32 bits, got {m}")
         check(self._w, lib.lc_body_set_thruster_mask(self._w, self.id, m))
-        levels = self._world._rec[self.id].levels
-        levels[:] = [1.0 if m >> i & 1 else 0.0 for i in range(len(levels))]
+
+    @property
+    def thruster_mask(self) -> int:
+        """Bit i on when thruster i fires (level > 0)."""
+        out = ffi.new("uint32_t *")
+        check(self._w, lib.lc_body_get_thruster_mask(self._w, self.id, out))
+        return int(out[0])
 
 
 class Thruster:
@@ -204,20 +234,25 @@ class Thruster:
         self.body, self.index = body, index
 
     def __repr__(self) -> str:
-        return f"<collide.Thruster {self.body!r}[{self.index}] level={self.level}>"
+        try:
+            level = f"level={self.level}"
+        except CollideError:  # the body or the thruster is gone
+            level = "gone"
+        return f"<collide.Thruster {self.body!r}[{self.index}] {level}>"
 
     @property
     def level(self) -> float:
-        """Last level set from Python (0 = off, 1 = full)."""
-        levels = self.body.world._rec[self.body.id].levels
-        return levels[self.index] if self.index < len(levels) else 0.0
+        """0 = off, 1 = full magnitude."""
+        w = self.body.world
+        out = ffi.new("double *")
+        check(w._w, lib.lc_body_get_thruster_level(w._w, self.body.id, self.index, out))
+        return float(out[0])
 
     @level.setter
     def level(self, value: float) -> None:
         lvl = cv.real(value, "level")
         w = self.body.world
         check(w._w, lib.lc_body_set_thruster_level(w._w, self.body.id, self.index, lvl))
-        w._rec[self.body.id].levels[self.index] = lvl
 
 
 class Spring:

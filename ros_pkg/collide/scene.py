@@ -336,9 +336,18 @@ def _thrusters(v: Any, path: Path_, p: _Parsed) -> Any:
     return _MISSING
 
 
+def _inertia(v: Any, path: Path_, p: _Parsed) -> Any:
+    val = _number(v, path, p)
+    if val is not _MISSING and not val > 0:
+        p.error(path, f"must be > 0 kg*m^2, got {val} (omit the key for the polygon's own inertia)")
+        return _MISSING
+    return val
+
+
 _BODY_COMMON = {"name": (_string, _MISSING), "shape": (_string, _MISSING), "position": (_vec2, [0.0, 0.0]),
                 "angle": (_number, 0.0), "velocity": (_vec2, [0.0, 0.0]), "angular_velocity": (_number, 0.0),
-                "mass": (_number, 1.0), "elasticity": (_number, 1.0), "friction": (_number, 0.0),
+                "mass": (_number, 1.0), "inertia": (_optional(_inertia), None),
+                "center_of_mass": (_optional(_vec2), None), "elasticity": (_number, 1.0), "friction": (_number, 0.0),
                 "static": (_boolean, False), "color": (_optional(_string), None),
                 "thrusters": (_optional(_thrusters), None),
                 "external": (_optional(lambda v, path, p: _mapping(
@@ -442,11 +451,19 @@ class Scene:
                 path = ("bodies", i)
                 common = dict(position=b["position"], angle=b["angle"], velocity=b["velocity"],
                               angular_velocity=b["angular_velocity"], mass=b["mass"], elasticity=b["elasticity"],
-                              friction=b["friction"], static=b["static"], name=b["name"])
-                if b["shape"] == "box":
-                    body = world.add_box(b["width"], b["height"], **common)
-                else:
-                    body = world.add_body(b["vertices"], **common)
+                              friction=b["friction"], static=b["static"], name=b["name"],
+                              inertia=b.get("inertia") or 0.0, center_of_mass=b.get("center_of_mass"))
+                try:
+                    if b["shape"] == "box":
+                        body = world.add_box(b["width"], b["height"], **common)
+                    else:
+                        body = world.add_body(b["vertices"], **common)
+                except CollideError as exc:
+                    # C names the field it refused: point at that key's line when the scene gives it
+                    for key in ("inertia", "center_of_mass"):
+                        if b.get(key) is not None and exc.message.startswith(key):
+                            path = ("bodies", i, key)
+                    raise
                 th = b.get("thrusters")
                 path = ("bodies", i, "thrusters")
                 if isinstance(th, dict):

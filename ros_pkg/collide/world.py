@@ -129,10 +129,7 @@ class World:
         check(self._w, lib.lc_world_set_damping(self._w, k, r))
 
     def set_elasticity(self, elasticity: float) -> None:
-        e = cv.real(elasticity, "elasticity")
-        check(self._w, lib.lc_world_set_elasticity(self._w, e))
-        for rec in self._rec.values():
-            rec.elasticity = e
+        check(self._w, lib.lc_world_set_elasticity(self._w, cv.real(elasticity, "elasticity")))
 
     # ---- time ----------------------------------------------------------------------------------
     @property
@@ -156,13 +153,12 @@ class World:
                 raise ValueError(f"a body named {n!r} already exists")
             seen.add(n)
 
-    def _register(self, body_id: int, name: str | None, elasticity: float, friction: float,
-                  sync: bool = True) -> "Body":
+    def _register(self, body_id: int, name: str | None, sync: bool = True) -> "Body":
         if name is None:
             name = f"body{body_id}"
             while name in self._by_name:
                 name += "_"
-        self._rec[body_id] = _Record(name, elasticity, friction)
+        self._rec[body_id] = _Record(name)
         self._by_name[name] = body_id
         if sync:
             self._sync_names()
@@ -173,8 +169,13 @@ class World:
 
     def add_body(self, vertices: Any, position: Any = (0.0, 0.0), angle: float = 0.0, velocity: Any = (0.0, 0.0),
                  angular_velocity: float = 0.0, mass: float = 1.0, elasticity: float = 1.0, friction: float = 0.0,
-                 static: bool = False, name: str | None = None) -> "Body":
-        """Add a convex polygon; vertices (k, 2) in the body frame, position = that frame's origin."""
+                 static: bool = False, name: str | None = None, inertia: float = 0.0,
+                 center_of_mass: Any = None) -> "Body":
+        """Add a convex polygon; vertices (k, 2) in the body frame, position = that frame's origin.
+
+        inertia: kg*m^2 about the centre of mass, in (0, mass * r^2] (r: the farthest vertex from the
+        centre of mass); 0 = the polygon's (uniform density). center_of_mass: (x, y) in the body frame,
+        inside the polygon; None = the polygon's centroid."""
         pts = cv.points(vertices, "vertices")
         d = ffi.new("lc_body_def *", lib.lc_default_body_def())
         d.type = lib.LC_BODY_STATIC if cv.flag(static, "static") else lib.LC_BODY_DYNAMIC
@@ -185,6 +186,10 @@ class World:
         d.mass = cv.real(mass, "mass")
         d.elasticity = cv.real(elasticity, "elasticity")
         d.friction = cv.real(friction, "friction")
+        d.inertia = cv.real(inertia, "inertia")
+        if center_of_mass is not None:
+            d.custom_center_of_mass = 1
+            d.center_of_mass.x, d.center_of_mass.y = cv.vec2(center_of_mass, "center_of_mass")
         self._check_new_names([name])
         verts = ffi.new("lc_vec2[]", max(len(pts), 1))
         if len(pts):
@@ -193,7 +198,7 @@ class World:
         d.vertex_count = len(pts)
         out = ffi.new("lc_body_id *")
         check(self._w, lib.lc_world_add_body(self._w, d, out))
-        return self._register(int(out[0]), name, d.elasticity, d.friction)
+        return self._register(int(out[0]), name)
 
     def add_box(self, width: float, height: float, **kwargs: Any) -> "Body":
         """Add a width x height rectangle centred on its position; other arguments as add_body."""
@@ -216,7 +221,7 @@ class World:
         self._check_new_names(names)
         ids = ffi.new("lc_body_id[4]")
         check(self._w, lib.lc_world_add_walls(self._w, *args, ids))
-        walls = [self._register(int(ids[i]), names[i], args[5], 0.0, sync=False) for i in range(4)]
+        walls = [self._register(int(ids[i]), names[i], sync=False) for i in range(4)]
         self._sync_names()
         return walls
 
@@ -322,6 +327,13 @@ class World:
     def set_stage_timing(self, on: bool) -> None:
         """Measure wall time per pipeline stage into the counters' time_* fields (s); off by default."""
         check(self._w, lib.lc_world_set_stage_timing(self._w, 1 if on else 0))
+
+    @property
+    def stage_timing(self) -> bool:
+        """Whether set_stage_timing is on."""
+        out = ffi.new("int *")
+        check(self._w, lib.lc_world_get_stage_timing(self._w, out))
+        return bool(out[0])
 
     def counters(self, last: bool = True) -> dict[str, Any]:
         """Work counters of the last step (last=True) or since creation (time_* in s: set_stage_timing)."""

@@ -18,7 +18,8 @@ extern "C" {
 
 /* Default world settings (gravity (0,-9.81) m/s^2, RK4, serial impacts, root-finder TOI). */
 LC_API lc_world_def lc_default_world_def(void);
-/* Default body: dynamic, 1 kg, elasticity 1, friction 0, no vertices yet. */
+/* Default body: dynamic, 1 kg, elasticity 1, friction 0, inertia and centre of mass from the polygon,
+ * no vertices yet. */
 LC_API lc_body_def lc_default_body_def(void);
 /* Default spring: stiffness 3 N/m, damping 0, rest length 0, anchored to the world. */
 LC_API lc_spring_def lc_default_spring_def(void);
@@ -76,12 +77,23 @@ LC_API lc_status lc_world_set_state(lc_world *world, const double *state, int co
 LC_API lc_status lc_body_set_pose(lc_world *world, lc_body_id id, lc_vec2 center, double angle);
 /* Sets a body's centre-of-mass velocity (m/s) and angular velocity (rad/s). */
 LC_API lc_status lc_body_set_velocity(lc_world *world, lc_body_id id, lc_vec2 velocity, double angular_velocity);
-/* Sets a dynamic body's mass (kg, > 0); the inertia scales with it. */
+/* Sets a dynamic body's mass (kg, > 0); the inertia scales with it (the radius of gyration is kept). */
 LC_API lc_status lc_body_set_mass(lc_world *world, lc_body_id id, double mass);
+/* A body's mass (kg; 0 for a static body). */
+LC_API lc_status lc_body_get_mass(const lc_world *world, lc_body_id id, double *out);
+/* Sets a dynamic body's moment of inertia about its centre of mass (kg*m^2, (0, mass * r^2], r the
+ * farthest vertex from the centre of mass), or with 0 the polygon's (uniform density) again. */
+LC_API lc_status lc_body_set_inertia(lc_world *world, lc_body_id id, double inertia);
+/* A body's moment of inertia about its centre of mass (kg*m^2; 0 for a static body). */
+LC_API lc_status lc_body_get_inertia(const lc_world *world, lc_body_id id, double *out);
 /* Sets a body's elasticity [0,1] and friction coefficient [0,10]. */
 LC_API lc_status lc_body_set_material(lc_world *world, lc_body_id id, double elasticity, double friction);
+/* A body's elasticity and friction coefficient (both outputs required). */
+LC_API lc_status lc_body_get_material(const lc_world *world, lc_body_id id, double *elasticity, double *friction);
 /* Sets a constant external force (N, world frame, at the centre of mass) and torque (N*m). */
 LC_API lc_status lc_body_set_external(lc_world *world, lc_body_id id, lc_vec2 force, double torque);
+/* A body's external force (N) and torque (N*m) (both outputs required; zero for a static body). */
+LC_API lc_status lc_body_get_external(const lc_world *world, lc_body_id id, lc_vec2 *force, double *torque);
 /* Number of vertices of a body. */
 LC_API int lc_body_vertex_count(const lc_world *world, lc_body_id id);
 /* Writes a body's vertices relative to its centre of mass, body frame (m), into out[capacity].
@@ -89,7 +101,8 @@ LC_API int lc_body_vertex_count(const lc_world *world, lc_body_id id);
 LC_API lc_status lc_body_get_local_vertices(const lc_world *world, lc_body_id id, lc_vec2 *out, int capacity);
 /* Writes a body's vertices in world coordinates (m) into out[capacity]. */
 LC_API lc_status lc_body_get_world_vertices(const lc_world *world, lc_body_id id, lc_vec2 *out, int capacity);
-/* Offset (m, body frame) from the body's local-frame origin to its centre of mass. */
+/* Offset (m, body frame) from the body's local-frame origin to its centre of mass: where the body's
+ * centre of mass is in its local frame (lc_body_def.center_of_mass when given, else the centroid). */
 LC_API lc_status lc_body_get_center_offset(const lc_world *world, lc_body_id id, lc_vec2 *out);
 
 /* ---- thrusters -------------------------------------------------------------------------- */
@@ -103,6 +116,10 @@ LC_API lc_status lc_body_add_default_thrusters(lc_world *world, lc_body_id id, d
 LC_API lc_status lc_body_set_thruster_level(lc_world *world, lc_body_id id, int index, double level);
 /* Sets every thruster of a body at once from a bit mask (bit i on = level 1, off = 0). */
 LC_API lc_status lc_body_set_thruster_mask(lc_world *world, lc_body_id id, uint32_t mask);
+/* A thruster's level in [0, 1]. */
+LC_API lc_status lc_body_get_thruster_level(const lc_world *world, lc_body_id id, int index, double *out);
+/* Bit i on when thruster i of the body fires (level > 0; a mask sets level 1), for every thruster. */
+LC_API lc_status lc_body_get_thruster_mask(const lc_world *world, lc_body_id id, uint32_t *out);
 /* Number of thrusters on a body (-1 for an unknown body). */
 LC_API int lc_body_thruster_count(const lc_world *world, lc_body_id id);
 
@@ -132,6 +149,8 @@ LC_API lc_status lc_world_get_energy(const lc_world *world, lc_energy *out);
 /* Measure wall time per pipeline stage into the counters' time_* fields (on = 1) or not (0, the default:
  * the clock reads cost ~2 x 25 ns per stage entry, ~5-15 % of a 20-block step). */
 LC_API lc_status lc_world_set_stage_timing(lc_world *world, int on);
+/* Whether stage timing is on (1) or off (0). */
+LC_API lc_status lc_world_get_stage_timing(const lc_world *world, int *out);
 /* Counters of the last step (last may be NULL) and since creation (total may be NULL). */
 LC_API lc_status lc_world_get_counters(const lc_world *world, lc_counters *last, lc_counters *total);
 /* 64-bit FNV-1a hash of time and every body's state bits, for determinism checks. */

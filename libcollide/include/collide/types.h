@@ -131,7 +131,9 @@ typedef struct lc_world_def {
 } lc_world_def;
 
 /* A body. Start from lc_default_body_def(). Vertices are in the body's local frame; the centre of
- * mass and moment of inertia are computed from the polygon (uniform density). */
+ * mass and moment of inertia are computed from the polygon (uniform density) unless given. A body's
+ * mass lies inside its polygon (the polygon is all that collides), so a given centre of mass must lie
+ * in the polygon and a given inertia cannot exceed mass * r^2, r the farthest vertex from it. */
 typedef struct lc_body_def {
     lc_body_type type;             /* default LC_BODY_DYNAMIC */
     const lc_vec2 *vertices;       /* m, local frame, convex, either winding, 3..LC_MAX_POLYGON_VERTICES */
@@ -143,6 +145,13 @@ typedef struct lc_body_def {
     double mass;                   /* kg, > 0 for dynamic bodies, ignored for static, default 1 */
     double elasticity;             /* coefficient of restitution, [0, 1], default 1 */
     double friction;               /* Coulomb coefficient, [0, 10], default 0 */
+    double inertia;                /* kg*m^2 about the centre of mass, (0, mass * r^2] with r the farthest
+                                      vertex from the centre of mass; 0 (default): the polygon's (uniform
+                                      density) about the centre of mass; ignored for static bodies */
+    int custom_center_of_mass;     /* 1: the centre of mass is center_of_mass; 0 (default): the polygon's
+                                      centroid, and center_of_mass is ignored */
+    lc_vec2 center_of_mass;        /* m, local frame, inside the polygon or on its boundary (static bodies
+                                      too: the state is that point's) */
 } lc_body_def;
 
 /* A thruster fixed to a body: a force of magnitude*level along direction, applied at point. */
