@@ -8,6 +8,7 @@
 #include <stdint.h>
 #include "collide/math.h"
 #include "collide/types.h"
+#include "collide/query.h"   /* queries: bodies at a point or in a box, ray casts, distance of two bodies */
 
 #ifdef __cplusplus
 extern "C" {
