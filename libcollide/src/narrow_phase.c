@@ -156,7 +156,7 @@ static int face_touches(const lc_world *w, const double *state, int inc, int ref
     return count;
 }
 
-double lc_pair_separation(const lc_world *w, const double *state, int a, int b)
+double lc_pair_separation_axis(const lc_world *w, const double *state, int a, int b, int *ref, int *edge)
 {
     frame fa = frame_of(w, state, a), fb = frame_of(w, state, b);
     lc_vec2 a_in_b[LC_MAX_POLYGON_VERTICES], b_in_a[LC_MAX_POLYGON_VERTICES];
@@ -166,7 +166,15 @@ double lc_pair_separation(const lc_world *w, const double *state, int a, int b)
     vertices_in(&w->shape[b], fb, fa, b_in_a);
     sb = max_separation(&w->shape[b], a_in_b, w->shape[a].count, &kb);
     sa = max_separation(&w->shape[a], b_in_a, w->shape[b].count, &ka);
+    *ref = sa > sb ? a : b;
+    *edge = sa > sb ? ka : kb;
     return sa > sb ? sa : sb;
+}
+
+double lc_pair_separation(const lc_world *w, const double *state, int a, int b)
+{
+    int ref, edge;
+    return lc_pair_separation_axis(w, state, a, b, &ref, &edge);
 }
 
 int lc_collect_touches(const lc_world *w, const double *state, int a, int b, double max_gap,

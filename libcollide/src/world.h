@@ -233,6 +233,8 @@ int lc_find_crossings(const lc_world *w, const double *s0, const double *s1, int
                       lc_buf *buf, int count);
 /* Largest separation of two bodies over the faces of both (< 0: overlapping), the separating axis test. */
 double lc_pair_separation(const lc_world *w, const double *state, int a, int b);
+/* The same, with the face it is measured along: edge `edge` of row `ref` (a or b). */
+double lc_pair_separation_axis(const lc_world *w, const double *state, int a, int b, int *ref, int *edge);
 /* Signed distance of vertex of a from the line of edge of b at state. */
 double lc_vertex_edge_gap(const lc_world *w, const double *state, int a, int vertex, int b, int edge);
 

@@ -15,6 +15,8 @@ from . import _convert as cv
 from ._ffi import CollideError, check, ffi, lib
 from ._views import COLLISION, CONTACT_DTYPE, RESTING, _view
 from .body import Body, BodyRef, Spring, Thruster, _Record, _vec
+from . import query as _query
+from .query import BodyDistance, RayHit
 
 __all__ = ["World", "Body", "Thruster", "Spring", "Energy", "CollideError", "CONTACT_DTYPE",
            "COLLISION", "RESTING", "WALL_NAMES"]
@@ -400,6 +402,35 @@ class World:
         out[:, 0] = st[rows, 0] + c * table[:, 0] - s * table[:, 1]
         out[:, 1] = st[rows, 1] + s * table[:, 0] + c * table[:, 1]
         return out, start.copy()
+
+    # ---- queries on the current poses (collide/query.h, collide/query.py) ------------------------
+    def query_point(self, point: Iterable[float], skip_static: bool = False,
+                    skip: BodyRef | None = None) -> list["Body"]:
+        """Bodies containing point (boundary included), in row order; skip: a body left out."""
+        return _query.query_point(self, point, skip_static, skip)
+
+    def query_box(self, lower: Iterable[float], upper: Iterable[float], skip_static: bool = False,
+                  skip: BodyRef | None = None) -> list["Body"]:
+        """Bodies sharing a point with the axis-aligned box [lower, upper], in row order."""
+        return _query.query_box(self, lower, upper, skip_static, skip)
+
+    def ray_cast(self, start: Iterable[float], end: Iterable[float], skip_static: bool = False,
+                 skip: BodyRef | None = None) -> RayHit | None:
+        """First body the segment from start to end meets (RayHit), or None."""
+        return _query.ray_cast(self, start, end, skip_static, skip)
+
+    def ray_cast_all(self, start: Iterable[float], end: Iterable[float], skip_static: bool = False,
+                     skip: BodyRef | None = None) -> list[RayHit]:
+        """Every body the segment meets, one RayHit each, sorted by fraction."""
+        return _query.ray_cast_all(self, start, end, skip_static, skip)
+
+    def body_distance(self, a: BodyRef, b: BodyRef) -> BodyDistance:
+        """Distance of two bodies (< 0: minus the penetration depth), normal from a to b, closest points."""
+        return _query.body_distance(self, a, b)
+
+    def bodies_overlap(self, a: BodyRef, b: BodyRef) -> bool:
+        """True when the two bodies share a point (touching counts)."""
+        return _query.bodies_overlap(self, a, b)
 
     @property
     def spring_count(self) -> int:

@@ -9,6 +9,7 @@
 #include "collide/export.h"
 #include "collide/math.h"
 #include "collide/types.h"
+#include "collide/query.h"   /* queries: bodies at a point or in a box, ray casts, distance of two bodies */
 
 #ifdef __cplusplus
 extern "C" {
