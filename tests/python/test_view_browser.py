@@ -94,8 +94,18 @@ class Stack:
             if got:
                 return got
             assert self.view.proc.poll() is None, f"the view exited while waiting for {what}:\n{self.view.output()}"
-            assert time.monotonic() < end, f"gave up waiting for {what}; view log:\n{self.view.output()[-3000:]}"
+            assert time.monotonic() < end, (f"gave up waiting for {what}; the page: {self.page_summary()}; "
+                                            f"view log:\n{self.view.output()[-3000:]}")
             self.client.ex.spin_once(timeout_sec=0.03)
+
+    def page_summary(self) -> str:
+        try:
+            return str(self.js("""(() => { const V = window.__view; return JSON.stringify({connected: V.connected,
+              node: V.node, t: V.t, sent: V.sent, grab: V.grab, refusals: V.refusals.slice(-5), replies:
+              V.replies.slice(-3), message: V.lastMessage, shapes: V.shapes.map((b) => [b.id, b.name, b.static]),
+              held: V.held}); })()"""))
+        except Exception as exc:  # the page itself is the problem
+            return f"(no page state: {exc})"
 
     def js(self, expr: str) -> Any:
         return self.page.evaluate(expr)
@@ -109,17 +119,26 @@ class Stack:
 
     def reset(self) -> None:
         """~/reset; then wait until the client and the page both show the new run: the default scene
-        starts at rest (every velocity exactly 0) and the page counts the node's DELETEALL marker."""
-        resets = self.js("window.__view.resets")
+        starts at rest (every velocity exactly 0, so the poses stay put) and the page shows those poses."""
         assert self.client.call(Empty, "reset") is not None, "sim/reset did not answer"
+        got: dict[str, Any] = {}
 
         def at_rest() -> bool:
             msg = self.client.fresh("bodies/states", timeout=5.0)
-            return msg is not None and all(t.linear.x == 0.0 and t.linear.y == 0.0 and t.angular.z == 0.0
-                                           for t in msg.twists)
+            if msg is None or not all(t.linear.x == 0.0 and t.linear.y == 0.0 and t.angular.z == 0.0
+                                      for t in msg.twists):
+                return False
+            got.update({n: (p.position.x, p.position.y) for n, p in zip(msg.names, msg.poses)})
+            return True
         self.until(at_rest, "bodies/states of the reset scene")
-        self.until(lambda: self.js("window.__view.resets") > resets and self.page_body("block1") is not None,
-                   "the page to show the reset scene")
+
+        def page_at_rest() -> bool:
+            for n, (x, y) in got.items():
+                b = self.page_body(n)
+                if b is None or abs(b["x"] - x) > 1e-9 or abs(b["y"] - y) > 1e-9:
+                    return False
+            return True
+        self.until(page_at_rest, "the page to show the reset scene")
 
     def state(self, name: str) -> tuple[float, ...]:
         s = self.client.body_state(name)
@@ -229,9 +248,12 @@ def test_holding_keys_fires_thrusters(stack: Stack) -> None:
         try:
             # S and J fire the left thruster (index 0) of their block: it gains velocity along -x
             stack.until(lambda: stack.state(body)[3] < v0 - 0.05, f"{key} to push {body}")
-            sent = [(m.body, list(m.firing)) for _, m in stack.client.history["thrusters"]]
-            sent = sent[len(sent) - (stack.client.count["thrusters"] - n0):]
-            assert sent and all(s == (body, [True, False, False, False]) for s in sent), sent
+
+            def since() -> list[tuple[str, list[bool]]]:
+                n = stack.client.count["thrusters"] - n0
+                return [(m.body, list(m.firing)) for _, m in list(stack.client.history["thrusters"])[-n:]] if n else []
+            stack.until(since, f"the view's ThrusterCommand for {body}")
+            assert all(s == (body, [True, False, False, False]) for s in since()), since()
         finally:
             kb.up(key)
         stack.until(lambda: stack.client.last["thrusters"].body == body
@@ -252,6 +274,33 @@ def test_gravity_from_the_page_and_refusal(stack: Stack) -> None:
     assert "refused" in text and "gravity" in text, text
     assert stack.client.get_params(["gravity"]) == {"gravity": 2.5}
     assert stack.client.set_params({"gravity": 0.0})[0].successful
+
+
+def test_pause_step_run_reset_buttons(stack: Stack) -> None:
+    page = stack.page
+
+    def click(button: str, request: str) -> dict[str, Any]:
+        n = stack.js("window.__view.replies.length")
+        page.click(button)
+        stack.until(lambda: stack.js("window.__view.replies.length") > n, f"the reply to {request}")
+        r = stack.js("window.__view.replies[window.__view.replies.length - 1]")
+        assert r["request"] == request and r["ok"], r
+        return r
+
+    click("#pause", "pause")
+    stack.until(lambda: (stack.js("window.__view.health") or {}).get("paused"), "the node's diagnostics: paused")
+    t1 = stack.js("window.__view.t")
+    stack.client.spin(0.3)
+    assert stack.js("window.__view.t") == t1  # paused: no sim time passes
+    click("#step", "step")  # 10 steps of 1 ms; the node publishes states every 10 steps
+    stack.until(lambda: stack.js("window.__view.t") > t1, "the page's sim time after 10 steps")
+    assert stack.js("window.__view.t") - t1 <= 0.02 + 1e-9
+    click("#resume", "pause")
+    t2 = stack.js("window.__view.t")
+    stack.until(lambda: stack.js("window.__view.t") > t2 + 0.2, "sim time to run again")
+    resets = stack.js("window.__view.resets")
+    click("#reset", "reset")
+    stack.until(lambda: stack.js("window.__view.resets") > resets, "the page to count the reset")
 
 
 def test_bad_websocket_input_is_refused(stack: Stack) -> None:
@@ -278,6 +327,28 @@ def test_bad_websocket_input_is_refused(stack: Stack) -> None:
     frames = stack.js("window.__view.frames")
     stack.until(lambda: stack.js("window.__view.frames") > frames + 5, "the page's stream to go on")
     assert stack.node.alive()
+
+
+def test_binds_loopback_and_refuses_other_origins(stack: Stack) -> None:
+    import asyncio
+    import concurrent.futures
+
+    from websockets.asyncio.client import connect
+    from websockets.exceptions import InvalidStatus
+    assert stack.view.url.startswith("http://127.0.0.1:")
+    listening = Path("/proc/net/tcp").read_text().splitlines()[1:]
+    local = {ln.split()[1] for ln in listening if ln.split()[3] == "0A"}  # state LISTEN
+    assert f"0100007F:{stack.view.port:04X}" in local  # 127.0.0.1, not 0.0.0.0
+
+    async def other_site() -> int:
+        try:
+            async with connect(f"ws://127.0.0.1:{stack.view.port}/ws", origin="http://example.com"):
+                return 101
+        except InvalidStatus as exc:
+            return exc.response.status_code
+    # playwright's sync API runs an event loop in this thread: the client gets a thread of its own
+    with concurrent.futures.ThreadPoolExecutor(1) as pool:
+        assert pool.submit(asyncio.run, other_site()).result(timeout=GIVE_UP) == 403
 
 
 def test_page_reconnects_after_node_and_view_restart(stack: Stack) -> None:

@@ -249,6 +249,11 @@ class ViewBridge(Node):
                     self.refresh_params()
                 reply(bool(r.successful), r.reason or (f"{args['name']} = {args['value']:g}"))
             elif kind == "reset":
+                # the node's DELETEALL marker may be overwritten in its depth-1 history before it
+                # reaches us: a reset asked for here starts the energy's start mark over at once
+                with self.lock:
+                    self.scene.restarted()
+                    self.scene.resets += 1
                 reply(True, "reset")
             else:
                 reply(bool(resp.success), resp.message)

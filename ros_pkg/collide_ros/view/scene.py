@@ -77,7 +77,7 @@ class SceneState:
     _rtf_ref: tuple[float, float] | None = None
     rtf: float | None = None
     seq: int = 0  # bumps on every change worth sending
-    resets: int = 0  # DELETEALL markers seen (a reset or a new node)
+    resets: int = 0  # DELETEALL markers seen and resets asked for by the view
 
     # ---------------------------------------------------------------- input
     def on_states(self, stamp: float, names: list[str], poses: list[Pose],
