@@ -28,6 +28,8 @@ from collide_ros.view.protocol import PARAMS
 from collide_ros.view.scene import SceneState, yaw_of
 
 THRUSTER_PERIOD = 0.1   # s: held thrusters are republished (the node drops a command after command_timeout)
+SERVICE_WAIT = 5.0      # s: how long a request waits for the node's service to appear
+ANSWER_WAIT = 15.0      # s: ... and for the node's answer
 WATCH_PERIOD = 0.5      # s: is the sim node there? parameters refreshed every other tick
 LATEST = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=5, reliability=ReliabilityPolicy.BEST_EFFORT,
                     durability=DurabilityPolicy.VOLATILE)
@@ -220,11 +222,14 @@ class ViewBridge(Node):
         self._active = set(fire)
 
     def call(self, kind: str, args: dict[str, Any], reply: Reply) -> None:
-        """Set a parameter or call pause/step/reset; ``reply(ok, message)`` runs on the executor
-        thread when the node answers (or at once when its service is not there)."""
+        """Set a parameter or call pause/step/reset and wait for the answer (call it on a worker
+        thread): ``reply(ok, message)`` is called once, also when the service is not there within
+        SERVICE_WAIT or the answer not within ANSWER_WAIT."""
         key = {"param": "set"}.get(kind, kind)
         cli = self._cli[key]
-        if not cli.service_is_ready():
+        # blocks up to SERVICE_WAIT: call it off the event loop (a node that just came up may not be
+        # matched yet)
+        if not cli.wait_for_service(timeout_sec=SERVICE_WAIT):
             reply(False, f"the sim node's service {cli.srv_name} is not available (is the node running "
                          "in this namespace and ROS_DOMAIN_ID?)")
             return
@@ -238,26 +243,29 @@ class ViewBridge(Node):
         else:
             req = Empty.Request()
         fut = cli.call_async(req)
-
-        def done(f: Any) -> None:
-            resp = f.result()
-            if resp is None:
-                reply(False, f"{cli.srv_name}: no answer")
-            elif kind == "param":
-                r = resp.results[0]
-                if r.successful:
-                    self.refresh_params()
-                reply(bool(r.successful), r.reason or (f"{args['name']} = {args['value']:g}"))
-            elif kind == "reset":
-                # the node's DELETEALL marker may be overwritten in its depth-1 history before it
-                # reaches us: a reset asked for here starts the energy's start mark over at once
-                with self.lock:
-                    self.scene.restarted()
-                    self.scene.resets += 1
-                reply(True, "reset")
-            else:
-                reply(bool(resp.success), resp.message)
-        fut.add_done_callback(done)
+        answered = threading.Event()
+        fut.add_done_callback(lambda _f: answered.set())
+        if not answered.wait(ANSWER_WAIT):
+            cli.remove_pending_request(fut)
+            reply(False, f"{cli.srv_name}: no answer within {ANSWER_WAIT:g} s")
+            return
+        resp = fut.result()
+        if resp is None:
+            reply(False, f"{cli.srv_name}: no answer")
+        elif kind == "param":
+            r = resp.results[0]
+            if r.successful:
+                self.refresh_params()
+            reply(bool(r.successful), r.reason or f"{args['name']} = {args['value']:g}")
+        elif kind == "reset":
+            # the node's DELETEALL marker may be overwritten in its depth-1 history before it
+            # reaches us: a reset asked for here starts the energy's start mark over at once
+            with self.lock:
+                self.scene.restarted()
+                self.scene.resets += 1
+            reply(True, "reset")
+        else:
+            reply(bool(resp.success), resp.message)
 
     # ---------------------------------------------------------------- snapshots (thread-safe)
     def snapshot(self) -> tuple[int, dict[str, Any]]:

@@ -31,6 +31,7 @@ from collide_ros.view import protocol
 from collide_ros.view.bridge import ViewBridge, spin_in_thread
 
 PAGE = Path(__file__).with_name("page.html")
+MAX_PENDING = 8  # parameter/service requests per page waiting for the node at once
 HEARTBEAT = 1.0  # s: a state frame at least this often, even when nothing changed
 
 
@@ -66,6 +67,10 @@ class ViewServer:
         client = next(self._ids)
         self.sessions += 1
         send_lock = asyncio.Lock()
+        pending = [0]  # requests sent to the node and not answered yet
+
+        def done_one() -> None:
+            pending[0] -= 1
         loop = asyncio.get_running_loop()
 
         async def send(obj: dict[str, Any]) -> None:
@@ -75,6 +80,7 @@ class ViewServer:
         def reply_soon(req_id: int | None, kind: str) -> Any:
             def reply(ok: bool, message: str) -> None:  # on the executor thread
                 msg = {"type": "reply", "id": req_id, "request": kind, "ok": ok, "message": message}
+                loop.call_soon_threadsafe(done_one)
                 asyncio.run_coroutine_threadsafe(_safe(send(msg)), loop)
             return reply
 
@@ -104,14 +110,24 @@ class ViewServer:
                     self.bridge.release(client)
                 elif cmd.type == "keys":
                     self.bridge.keys(client, cmd.args["held"])
-                else:
-                    self.bridge.call(cmd.type, cmd.args, reply_soon(cmd.id, cmd.type))
+                elif pending[0] >= MAX_PENDING:
+                    await send({"type": "refused", "id": cmd.id, "reason":
+                                f"busy: {pending[0]} requests still wait for the sim node's answer"})
+                else:  # may wait for the node's service: on a worker thread
+                    pending[0] += 1
+                    loop.run_in_executor(None, self._call, cmd.type, cmd.args, reply_soon(cmd.id, cmd.type))
         except ConnectionClosed:
             pass
         finally:
             streamer.cancel()
             self.bridge.forget(client)
             self.sessions -= 1
+
+    def _call(self, kind: str, args: dict[str, Any], reply: Any) -> None:
+        try:
+            self.bridge.call(kind, args, reply)
+        except Exception as exc:  # the page gets an answer whatever happens
+            reply(False, f"view: {type(exc).__name__}: {exc}")
 
     async def _stream(self, ws: ServerConnection, send: Any) -> None:
         version = -1
