@@ -311,6 +311,39 @@ def test_pause_step_run_reset_buttons(stack: Stack) -> None:
     stack.until(lambda: stack.js("window.__view.resets") > resets, "the page to count the reset")
 
 
+def test_spawned_body_appears_and_killed_body_goes(stack: Stack) -> None:
+    from libcollide_msgs.srv import Kill, Spawn
+    stack.reset()
+    req = Spawn.Request(name="crate", width=1.0, height=1.0, mass=2.0, elasticity=1.0)
+    req.pose.position.x, req.pose.position.y = 0.0, -4.0
+    r = stack.client.call(Spawn, "spawn", req)
+    assert r is not None and r.success, r
+    stack.until(lambda: (stack.page_body("crate") or {}).get("dynamic"), "the spawned crate on the page")
+    b = stack.page_body("crate")
+    assert abs(b["x"]) < 1e-9 and abs(b["y"] + 4.0) < 1e-9 and not b["static"]
+    assert stack.js("window.__view.shapes.length") == 7  # 4 walls, 2 blocks, the crate
+    k = stack.client.call(Kill, "kill", Kill.Request(name="crate"))
+    assert k is not None and k.success, k
+    stack.until(lambda: stack.page_body("crate") is None and stack.js("window.__view.shapes.length") == 6,
+                "the killed crate to go from the page")
+
+
+def test_energy_bars(stack: Stack) -> None:
+    page = stack.page
+    assert not page.is_visible("#energy")
+    page.check("#show-energy")
+    assert page.is_visible("#energy")
+    e = stack.until(lambda: stack.js("window.__view.energy"), "energy on the page")
+    for key in ("potential", "rotational", "translational", "total", "start"):
+        assert key in e and math.isfinite(e[key]), e
+    # the bars are drawn (on the next animation frame): some pixels of the energy canvas are not blank
+    drawn = """(() => { const c = document.getElementById('energy');
+      const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;
+      let n = 0; for (let i = 3; i < d.length; i += 4) if (d[i] > 0) n++; return n; })()"""
+    stack.until(lambda: stack.js(drawn) > 100, "the energy bars drawn")
+    page.uncheck("#show-energy")
+
+
 def test_bad_websocket_input_is_refused(stack: Stack) -> None:
     # a second page's socket sends junk; each is refused with a reason and the view keeps streaming
     out = stack.page.evaluate("""async () => {

@@ -140,3 +140,21 @@ def test_scene_delete_all_and_energy_start() -> None:
     # a body that is no longer among the markers (killed) goes
     s.on_markers(3.0, [marker("bodies", 2, 0.0, 0.0, SQUARE)])
     assert [b["id"] for b in s.shapes_message()["bodies"]] == [2]
+
+
+def test_scene_spawn_within_a_step_names_the_new_body() -> None:
+    # states at t = 1 with two blocks; a spawn before the next step: markers of three bodies with the
+    # same stamp; the next states name all three
+    s = SceneState()
+    s.on_states(1.0, ["a", "b"], [(1.0, 0.0, 0.0), (2.0, 0.0, 0.0)], [(0.0, 0.0, 0.0)] * 2, wall=0.0)
+    walls_and = [marker("bodies", 1, 0.0, -6.0, SQUARE), marker("bodies", 2, 1.0, 0.0, SQUARE),
+                 marker("bodies", 3, 2.0, 0.0, SQUARE)]
+    s.on_markers(1.0, walls_and)
+    assert s.matched and s.name_of == {2: "a", 3: "b"}
+    s.on_markers(1.0, walls_and + [marker("bodies", 4, 0.0, 3.0, SQUARE)])
+    s.on_states(1.01, ["a", "b", "crate"], [(1.0, 0.0, 0.0), (2.0, 0.0, 0.0), (0.0, 3.0, 0.0)],
+                [(0.0, 0.0, 0.0)] * 3, wall=0.1)
+    assert not s.matched  # the body set changed: named again with the next markers
+    s.on_markers(1.01, walls_and + [marker("bodies", 4, 0.0, 3.0, SQUARE)])
+    assert s.matched and s.name_of == {2: "a", 3: "b", 4: "crate"}
+    assert [b["static"] for b in s.shapes_message()["bodies"]] == [True, False, False, False]

@@ -73,7 +73,8 @@ class SceneState:
     energy_start: float | None = None
     contacts: list[tuple[float, list[list[float]]]] = field(default_factory=list)  # (wall time, points)
     marker_stamp: float | None = None
-    _states_by_stamp: "OrderedDict[float, list[Pose]]" = field(default_factory=OrderedDict)
+    # stamp -> (names, poses) of the states messages received lately
+    _states_by_stamp: "OrderedDict[float, tuple[tuple[str, ...], list[Pose]]]" = field(default_factory=OrderedDict)
     _rtf_ref: tuple[float, float] | None = None
     rtf: float | None = None
     seq: int = 0  # bumps on every change worth sending
@@ -92,7 +93,7 @@ class SceneState:
         self.poses = dict(zip(names, poses))
         self.twists = dict(zip(names, twists))
         self.sim_time = stamp
-        self._states_by_stamp[stamp] = list(poses)
+        self._states_by_stamp[stamp] = (tuple(names), list(poses))
         while len(self._states_by_stamp) > 100:
             self._states_by_stamp.popitem(last=False)
         if not self.matched and self.marker_stamp == stamp:
@@ -154,16 +155,19 @@ class SceneState:
         self.marker_stamp = stamp
         if not self.matched and self.names:
             got = self._states_by_stamp.get(stamp) if stamp is not None else None
-            if got is not None:
-                self._match(got)
-            elif self.poses:  # e.g. paused: the latest states still hold the poses
+            # the states of this step, unless the bodies changed in it (a spawn between two steps
+            # keeps the stamp): then the latest states, which match if nothing moved (e.g. paused)
+            if got is not None and got[0] == tuple(self.names):
+                self._match(got[1])
+            else:
                 self._match([self.poses[n] for n in self.names])
         self.seq += 1
 
     def _match(self, state_poses: list[Pose]) -> None:
+        """Name the shapes of the dynamic bodies; ``state_poses`` in the order of self.names."""
         shapes = list(self.shapes.values())
         rows = match_rows([s.pose for s in shapes], state_poses)
-        if rows is None:
+        if rows is None or len(rows) != len(self.names):
             return
         self.name_of = {shapes[i].id: name for i, name in zip(rows, self.names)}
         self.matched = True
