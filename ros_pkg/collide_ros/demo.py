@@ -14,6 +14,8 @@
 4. stops both, renders out/demo.gif from the bag and prints a summary: collisions,
    energy drift over the force-free coast, real-time factor, where the bag and GIF are.
 With --replay it also replays the bag into a fresh node and checks the poses bit for bit.
+While the node runs, the live view (python -m collide_ros.view) serves the sim on
+http://127.0.0.1:8080/ (or a free port when 8080 is taken); its URL is printed (--no-view: not started).
 """
 from __future__ import annotations
 
@@ -250,6 +252,21 @@ class Proc:
         return int(self.proc.returncode)
 
 
+def start_view(out: Path, port: int = 8080, wait: float = 30.0) -> tuple[Proc | None, str | None]:
+    """The live view next to the demo's node: (process, URL), or (None, None) if it did not come up
+    (the demo goes on without it). A taken ``port`` falls back to a free one."""
+    for p in (port, 0):
+        view = Proc([sys.executable, "-m", "collide_ros.view", "--port", str(p)], out / "demo_view.log")
+        end = time.monotonic() + wait
+        while time.monotonic() < end and view.proc.poll() is None:
+            for ln in list(view.lines):
+                if ln.startswith("view: open "):
+                    return view, ln.split()[-1]
+            time.sleep(0.05)
+        view.stop()
+    return None, None
+
+
 def node_cmd() -> list[str]:
     from .replay import NODE_CMD
     return list(NODE_CMD)
@@ -323,7 +340,7 @@ def summarize(msgs: dict[str, list[tuple[int, Any]]], t0: float, coast_from: flo
 
 # ------------------------------------------------------------------ main
 
-def run(out: Path, duration: float, gif: bool, do_replay: bool) -> int:
+def run(out: Path, duration: float, gif: bool, do_replay: bool, view: bool = True) -> int:
     import rclpy
 
     from .render import read_bag, render_bag
@@ -347,6 +364,7 @@ def run(out: Path, duration: float, gif: bool, do_replay: bool) -> int:
     rclpy.init(args=[])
     drv = Driver()
     rec: Proc | None = None
+    viewer: Proc | None = None
     wall0 = time.monotonic()
     try:
         # node up: its command subscriptions match our publishers and /clock ticks
@@ -356,6 +374,13 @@ def run(out: Path, duration: float, gif: bool, do_replay: bool) -> int:
                 raise RuntimeError(f"node did not come up; see {node.log_path}")
             drv.spin(0.05)
         print(f"demo: node up (sim time {drv.sim_time:.2f} s)", flush=True)
+        if view:
+            viewer, url = start_view(out)
+            if url:
+                print(f"demo: live view: open {url} in a browser while the demo runs "
+                      "(mouse: spring; keys S,D,F,E / J,K,L,I: thrusters)", flush=True)
+            else:
+                print(f"demo: the live view did not start; see {out / 'demo_view.log'}", flush=True)
         topics = NODE_TOPICS + COMMAND_TOPICS + ECHO_TOPICS
         rec = Proc([sys.executable, "-m", "collide_ros.recorder", "--out", str(bag), "--params-of",
                     "sim", "--topics", *topics], out / "demo_recorder.log")
@@ -389,6 +414,8 @@ def run(out: Path, duration: float, gif: bool, do_replay: bool) -> int:
         drv.spin(0.3)
     finally:
         rc_rec = rec.stop() if rec is not None else -1
+        if viewer is not None:
+            viewer.stop()
         drv.close()
         rclpy.try_shutdown()
         node.stop()
@@ -459,8 +486,9 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--duration", type=float, default=10.0, help="scripted sim seconds")
     p.add_argument("--no-gif", action="store_true")
     p.add_argument("--replay", action="store_true", help="also replay the bag and check bit-exactness")
+    p.add_argument("--no-view", action="store_true", help="do not start the live view next to the node")
     a = p.parse_args(argv)
-    return run(Path(a.out), a.duration, not a.no_gif, a.replay)
+    return run(Path(a.out), a.duration, not a.no_gif, a.replay, not a.no_view)
 
 
 if __name__ == "__main__":

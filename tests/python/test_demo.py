@@ -40,6 +40,7 @@ def test_summary(demo: tuple[Path, str]) -> None:
     out, stdout = demo
     for key in ("energy drift:", "real-time factor:", "bag:", "GIF:", "replay:"):
         assert key in stdout
+    assert "demo: live view: open http://127.0.0.1:" in stdout  # the live view ran next to the node
     s = json.loads((out / "demo_summary.json").read_text())
     # e = 1, no damping, no gravity and no command in the coast: the engine's event-accurate
     # impacts keep energy to round-off (~1e-15); 1e-9 is the project's target (issue 2)
