@@ -634,6 +634,19 @@ static double energy_guard(island_ctx *c, double e0, double size0)
     return ke < excess ? excess - ke : 0.0;
 }
 
+/* A touch's slot in a table of mask + 1 (a power of two) entries: its bodies, vertex and edge packed into
+ * 64 bits and mixed by two multiplications (splitmix's finaliser), so that a pile's neighbouring rows and
+ * small vertex and edge numbers do not land in runs of adjacent slots and lengthen the probes. */
+static uint32_t touch_slot(const lc_touch *t, uint32_t mask)
+{
+    uint64_t key = ((uint64_t)(uint32_t)t->a << 32 | (uint32_t)t->b) ^ ((uint64_t)(uint32_t)t->vertex << 48) ^
+                   ((uint64_t)(uint32_t)t->edge << 16);
+    uint64_t h = key * 0x9E3779B97F4A7C15ull;
+    h ^= h >> 29;
+    h *= 0xBF58476D1CE4E5B9ull;
+    return (uint32_t)(h >> 32) & mask;
+}
+
 /* The touches at the end, their forces from the last flow's rows (matched by vertex and edge), reported
  * as resting contacts and kept for the next step's warm start; bodies on a pair with e < 1 are marked. */
 static int finish(island_ctx *c, lc_touch *end, int nend, const lc_touch *t, const lc_contact_row *rows, int nt,
@@ -646,16 +659,14 @@ static int finish(island_ctx *c, lc_touch *end, int nend, const lc_touch *t, con
     if (table == NULL) return -1;
     for (i = 0; i < size; ++i) table[i] = -1;
     for (i = 0; i < nt; ++i) {
-        uint32_t k = ((uint32_t)t[i].a * 2654435761u ^ (uint32_t)t[i].vertex * 40503u ^ (uint32_t)t[i].b * 97u ^
-                      (uint32_t)t[i].edge) & (uint32_t)(size - 1);
+        uint32_t k = touch_slot(&t[i], (uint32_t)(size - 1));
         while (table[k] >= 0) k = (k + 1) & (uint32_t)(size - 1);
         table[k] = i;
     }
     for (i = 0; i < nend; ++i) {
         lc_touch *x = &end[i];
         if (!(x->gap < w->def.contact_distance)) continue;   /* held near by the projection only */
-        uint32_t k = ((uint32_t)x->a * 2654435761u ^ (uint32_t)x->vertex * 40503u ^ (uint32_t)x->b * 97u ^
-                      (uint32_t)x->edge) & (uint32_t)(size - 1);
+        uint32_t k = touch_slot(x, (uint32_t)(size - 1));
         double fn = 0.0, ft = 0.0;
         while (table[k] >= 0) {
             const lc_touch *y = &t[table[k]];
