@@ -193,10 +193,17 @@ class SimNode(Node):
             if spec.name == sf.name:
                 continue
             default = spec.default
+            if spec.name == "frame_prefix":
+                default = params.frame_prefix_for(self.get_namespace())
             if spec.name in self._scene_defaults:
                 default = min(max(self._scene_defaults[spec.name], spec.lo), spec.hi)
             self._declare(spec, default)
         self._p: dict[str, Any] = {s.name: self.get_parameter(s.name).value for s in params.SPECS}
+        for name in ("world_frame", "frame_prefix"):  # the on-set callback checks them from here on
+            why = params.check({name: self._p[name]}, set())
+            if why:
+                raise InvalidParameterValueException(name, self._p[name], why)
+        self._refuse_sim_time()
         # ---- world ----
         self._time_offset = 0.0
         self._paused = bool(self._p["start_paused"])
@@ -208,7 +215,8 @@ class SimNode(Node):
         self._pub_states = self._publisher(BodyStates, "bodies/states", state_qos)
         self._pub_contacts = self._publisher(Contacts, "contacts", state_qos)
         self._pub_energy = self._publisher(Energy, "energy", state_qos)
-        self._pub_clock = self._publisher(Clock, "/clock", qos.CLOCK)
+        # one /clock per domain: a sim beside the clock owner leaves it out (publish_clock, read-only)
+        self._pub_clock = self._publisher(Clock, "/clock", qos.CLOCK) if self._p["publish_clock"] else None
         self._pub_tf = self._publisher(TFMessage, "/tf", qos.TF)
         self._pub_markers = self._publisher(MarkerArray, "markers", qos.MARKERS)
         self._pub_diag = self._publisher(DiagnosticArray, "/diagnostics", qos.DIAGNOSTICS)
@@ -265,7 +273,20 @@ class SimNode(Node):
         self.get_logger().info(
             f"sim ready: {len(self.world.names)} bodies ({', '.join(self._dyn_names[:8])}"
             f"{' ...' if len(self._dyn_names) > 8 else ''}), dt {self._p['time_step']} s, "
-            f"RTF {self._p['real_time_factor']}, {'paused' if self._paused else 'running'}")
+            f"RTF {self._p['real_time_factor']}, {'paused' if self._paused else 'running'}, "
+            f"frame prefix '{self._p['frame_prefix']}', "
+            + ("publishing /clock" if self._pub_clock is not None else "not publishing /clock (publish_clock false)"))
+
+    def _refuse_sim_time(self) -> None:
+        """The sim is the clock: use_sim_time would make its node clock follow its own /clock (or, with
+        publish_clock false, another sim's), standing still while it is paused. Launch files often set
+        use_sim_time for every node, so it is not a start failure: the value is reset to false with an
+        error in the log, and the on-set callback refuses true later (_on_set_parameters)."""
+        if self.get_parameter("use_sim_time").value is True:
+            self.set_parameters([Parameter("use_sim_time", Parameter.Type.BOOL, False)])
+            self.get_logger().error(
+                "use_sim_time:=true ignored: this node is the sim and publishes the sim time itself; it keeps "
+                "wall time (set use_sim_time only on the nodes that consume /clock)")
 
     def _publisher(self, msg_type: Any, topic: str, profile: Any) -> _CountedPublisher:
         """A counted publisher; its count is ``published/<topic without a leading '/'>`` in /diagnostics."""
@@ -364,7 +385,8 @@ class SimNode(Node):
         frame = self._p["world_frame"]
         self._cdr_poses = cdr.PoseArrayCdr(len(self._dyn_rows), frame)
         self._cdr_states = cdr.BodyStatesCdr(self._dyn_names, frame)
-        self._cdr_tf = cdr.TFMessageCdr(frame, self._dyn_names)
+        prefix = self._p["frame_prefix"]
+        self._cdr_tf = cdr.TFMessageCdr(frame, [prefix + n for n in self._dyn_names])
         self._cdr_contacts = cdr.ContactsCdr(frame, self._name_of_id)
         outlines, colors = [], []
         for i, n in enumerate(self._names):
@@ -515,12 +537,13 @@ class SimNode(Node):
                          f"|torque| {abs(t.z):.6g} N*m exceeds max_thrust {lim:g}")
             return
         frame = msg.header.frame_id
-        if frame in ("", name):
+        if frame in ("", name, self._p["frame_prefix"] + name):
             in_world = False
         elif frame == self._p["world_frame"]:
             in_world = True
         else:
-            self._reject(f"thrust:{name}:frame", f"{name}/thrust: frame_id '{frame}' is neither '' / '{name}' "
+            body_frames = " / ".join(f"'{f}'" for f in dict.fromkeys(("", name, self._p["frame_prefix"] + name)))
+            self._reject(f"thrust:{name}:frame", f"{name}/thrust: frame_id '{frame}' is neither {body_frames} "
                          f"(body frame) nor '{self._p['world_frame']}' (world frame)")
             return
         if name not in self._row_of:
@@ -786,6 +809,11 @@ class SimNode(Node):
 
     # ================================================================== parameters
     def _on_set_parameters(self, plist: list[Parameter]) -> SetParametersResult:
+        if any(p.name == "use_sim_time" and p.value is True for p in plist):
+            why = ("use_sim_time: the sim publishes the sim time itself and keeps wall time; set use_sim_time "
+                   "on the nodes that consume /clock")
+            self._warn("param:use_sim_time", f"parameter rejected: {why}")
+            return SetParametersResult(successful=False, reason=why)
         cand = {p.name: p.value for p in plist if p.name in params.BY_NAME}
         why = params.check(cand, set(self._dyn_names))
         if why:
@@ -823,7 +851,7 @@ class SimNode(Node):
             self._schedule_dirty = True
         elif name == "real_time_factor":
             self._schedule_dirty = True
-        elif name == "world_frame":
+        elif name in ("world_frame", "frame_prefix"):
             self._on_topology()
         elif name == "cmd_vel_stamped":
             self._make_cmd_vel_sub()
@@ -960,7 +988,7 @@ class SimNode(Node):
         self._step_time_sum += dt_step
         self._step_time_max = max(self._step_time_max, dt_step)
         s = self.steps
-        if self._every_clock and s % self._every_clock == 0:
+        if self._pub_clock is not None and self._every_clock and s % self._every_clock == 0:
             sec, ns = cdr.split_time(self.sim_time)
             self._pub_clock.publish(cdr.clock_cdr(sec, ns))
         if s % self._every_state == 0:
@@ -1044,7 +1072,7 @@ class SimNode(Node):
         n = max(self._window_steps, 1)
         target = float(self._p["real_time_factor"])
         st = DiagnosticStatus()
-        st.name = f"{self.get_name()}: physics"
+        st.name = f"{self.get_fully_qualified_name()}: physics"  # /robot1/sim: physics, /sim: physics
         st.hardware_id = "libcollide " + collide.version()
         slow = target > 0 and not self._paused and self.last_rtf < 0.9 * target
         st.level = DiagnosticStatus.WARN if slow else DiagnosticStatus.OK

@@ -39,7 +39,13 @@ SPECS: tuple[Spec, ...] = (
     Spec("clock_rate", 1000.0, "Rate (Hz of sim time) of /clock, at most every step", 1.0, 100000.0),
     Spec("command_timeout", 1.0, "Seconds (sim time) after the last thrust/thrusters/cmd_vel command before "
          "that command is dropped; 0 = hold the last command", 0.0, 60.0),
-    Spec("world_frame", "world", "Frame id of every header and parent of /tf"),
+    Spec("world_frame", "world", "Frame id of every header and parent of /tf; not prefixed by frame_prefix, so "
+         "sims side by side share one TF tree rooted in it"),
+    Spec("frame_prefix", "", "Prefix of the body frames: /tf children and the body frame of <body>/thrust are "
+         "<frame_prefix><body>; world_frame is not prefixed. Default: the node's namespace without its leading "
+         "'/' plus '/' ('robot1/' under /robot1), empty in the root namespace"),
+    Spec("publish_clock", True, "Publish /clock (this sim's time). One clock per ROS domain: with several sims "
+         "side by side, set it false on all but one; read-only (set at start)", read_only=True),
     Spec("cmd_vel_stamped", False, "cmd_vel carries TwistStamped (true) or Twist (false)"),
     Spec("cmd_vel_body", "block1", "Body driven by cmd_vel"),
     Spec("cmd_vel_linear_gain", 5.0, "cmd_vel servo: force = m*gain*(v_cmd - v) (1/s)", 0.0, 1000.0),
@@ -60,6 +66,12 @@ BY_NAME = {s.name: s for s in SPECS}
 
 _FRAME_RE = re.compile(r"^[A-Za-z_][A-Za-z0-9_\-./]*$")
 _NAME_RE = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
+
+
+def frame_prefix_for(namespace: str) -> str:
+    """The default frame_prefix of a node in ``namespace``: '/robot1' -> 'robot1/', '/' -> ''."""
+    ns = namespace.strip("/")
+    return f"{ns}/" if ns else ""
 
 
 def descriptor(spec: Spec) -> ParameterDescriptor:
@@ -100,6 +112,10 @@ def check(values: dict[str, Any], body_names: set[str]) -> str | None:
         why = valid_frame(values["world_frame"])
         if why:
             return f"world_frame: {why}"
+    if values.get("frame_prefix"):
+        why = valid_frame(values["frame_prefix"])
+        if why:
+            return f"frame_prefix: {why}"
     if "cmd_vel_body" in values and values["cmd_vel_body"] not in body_names:
         return f"cmd_vel_body: no dynamic body named '{values['cmd_vel_body']}' (have: {', '.join(sorted(body_names))})"
     return None

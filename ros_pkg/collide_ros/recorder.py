@@ -9,7 +9,8 @@ publisher is reliable, transient_local only if every publisher is. Message defin
 RIHS01 type hashes come from the installed interface packages (libcollide_msgs and our
 rebuilt tf2_msgs) and from rosbags' Jazzy typestore for the standard messages; the hash of
 our own types is checked against the hash rosidl generated. Stops on --duration, SIGINT or
-SIGTERM, then prints the message count per topic.
+SIGTERM, then prints the message count per topic. The bag's metadata (metadata.yaml and the MCAP
+file's own copy) says ``ros_distro: jazzy``.
 """
 from __future__ import annotations
 
@@ -17,6 +18,7 @@ import argparse
 import importlib
 import json
 import os
+import re
 import signal
 import sys
 import time
@@ -28,6 +30,11 @@ from typing import Any, Iterable
 EXCLUDED = frozenset({"/rosout", "/parameter_events"})
 OWN_PACKAGES = ("libcollide_msgs", "tf2_msgs")
 COMMAND_TOPICS = ("thrusters", "spring", "cmd_vel")  # plus every "<body>/thrust"
+#: the bag's ros_distro (metadata.yaml and the MCAP file's rosbag2 metadata record): the ROS 2
+#: release whose bag format, message definitions and type hashes the bag has. rosbags writes
+#: "rosbags" there and has no option for it, so the recorder rewrites it (_set_ros_distro).
+ROS_DISTRO = "jazzy"
+_ROS_DISTRO_LINE = re.compile(r"^(\s*ros_distro:[ \t]*)\S.*$", re.MULTILINE)
 
 
 # ------------------------------------------------------------------ types / typestore
@@ -211,8 +218,29 @@ class Recorder:
             for s in self.subs.values():
                 if s is not None:
                     self.node.destroy_subscription(s)
-            self.writer.close()
+            _set_ros_distro(self.writer)
         return dict(self.counts)
+
+
+def _ros_distro_yaml(text: str) -> str:
+    """The metadata YAML ``text`` with its ros_distro value set to ROS_DISTRO."""
+    out, n = _ROS_DISTRO_LINE.subn(lambda m: m.group(1) + ROS_DISTRO, text)
+    if n != 1:
+        raise RuntimeError(f"bag metadata holds {n} ros_distro lines, expected 1")
+    return out
+
+
+def _set_ros_distro(writer: Any) -> None:
+    """writer.close(), with ros_distro: ROS_DISTRO in the metadata it writes into the storage file
+    and into metadata.yaml."""
+    storage = writer.storage
+    storage_close = storage.close
+    storage.close = lambda version, metadata: storage_close(version, _ros_distro_yaml(metadata))
+    writer.close()
+    meta: Path = writer.metapath
+    tmp = meta.with_suffix(".yaml.tmp")
+    tmp.write_text(_ros_distro_yaml(meta.read_text("utf8")), "utf8")
+    tmp.replace(meta)
 
 
 def snapshot_params(node: Any, target: str, timeout: float = 5.0) -> dict[str, Any] | None:

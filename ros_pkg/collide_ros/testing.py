@@ -79,8 +79,9 @@ class NodeProcess:
 COUNT_PREFIXES = ("published/", "received/", "accepted/", "rejected/", "lost/")
 
 
-def diag_values(msg: Any, name: str = "sim") -> dict[str, str] | None:
-    """The values of the ``<name>: physics`` status of a DiagnosticArray (None if it has none)."""
+def diag_values(msg: Any, name: str = "/sim") -> dict[str, str] | None:
+    """The values of the ``<name>: physics`` status of a DiagnosticArray (None if it has none);
+    ``name`` is the node's fully qualified name (``/sim``, ``/robot1/sim``)."""
     for st in msg.status:
         if st.name == f"{name}: physics":
             return {kv.key: kv.value for kv in st.values}
@@ -195,7 +196,7 @@ class SimClient:
         end = time.monotonic() + timeout
         while time.monotonic() < end:
             msg = self.fresh("diagnostics", timeout=max(0.0, end - time.monotonic()))
-            vals = None if msg is None else diag_values(msg, self.sim.rsplit("/", 1)[-1])
+            vals = None if msg is None else diag_values(msg, self.sim)
             if vals is not None:
                 return vals
         return None

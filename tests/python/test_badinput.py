@@ -326,6 +326,8 @@ def _bad_values(spec: node_params.Spec) -> list[tuple[Any, str]]:
     out = [(1.5, "double for string"), (True, "bool for string")]
     if spec.name == "world_frame":
         out += [("", "empty frame"), ("/world", "leading slash"), ("my frame", "space in frame")]
+    if spec.name == "frame_prefix":
+        out += [("/robot1/", "leading slash"), ("my robot/", "space in frame")]
     if spec.name == "cmd_vel_body":
         out += [("", "empty body"), ("ghost", "unknown body"), ("wall_left", "static body")]
     return out
@@ -356,4 +358,6 @@ def test_every_parameter_refuses_bad_values(sim: SimClient) -> None:
     assert refused["world_frame space in frame"] == ("world_frame: frame id 'my frame' has characters other "
                                                      "than letters, digits, '_', '-', '.', '/'")
     assert "no dynamic body named 'wall_left'" in refused["cmd_vel_body static body"]
+    assert refused["frame_prefix leading slash"] == "frame_prefix: frame id '/robot1/' must not start with '/'"
+    assert "read-only" in refused["publish_clock read-only"]
     assert len(PARAM_CASES) > 100

@@ -95,6 +95,7 @@ def test_publishes_everything(sim: SimClient) -> None:
     bodies = [m for m in sim.last["markers"].markers if m.ns == "bodies"]
     assert len(bodies) == 6  # 4 walls + 2 blocks
     diag = sim.fresh("diagnostics", timeout=5.0)
+    assert [st.name for st in diag.status] == ["/sim: physics"]  # the fully qualified node name
     values = {kv.key: kv.value for kv in diag.status[0].values}
     assert float(values["real_time_factor"]) > 0.0 and float(values["step_time_mean_ms"]) > 0.0
     # message counts (test_node_diagnostics.py checks them against a subscriber)
@@ -342,6 +343,7 @@ def test_bad_input_rejected_while_simulating(sim: SimClient) -> None:
     s1, s2 = sim.body_state("block1"), sim.body_state("block2")
     assert s1[3] == 0.0 and s2[3] == 0.0 and s2[4] == 0.0
     diag = sim.fresh("diagnostics", timeout=5.0)
+    assert [st.name for st in diag.status] == ["/sim: physics"]  # the fully qualified node name
     values = {kv.key: kv.value for kv in diag.status[0].values}
     assert int(values["rejected_commands"]) >= len(expected)
     # counted per command topic too (earlier tests' rejections add to these)

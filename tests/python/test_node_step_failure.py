@@ -187,4 +187,4 @@ def _diagnostics(sim: SimNode) -> Any:
 
 def test_split_steps_in_diagnostics(sim: SimNode) -> None:
     sim.split_steps = 3
-    assert (diag_values(_diagnostics(sim)) or {})["split_steps"] == "3"
+    assert (diag_values(_diagnostics(sim), sim.get_fully_qualified_name()) or {})["split_steps"] == "3"

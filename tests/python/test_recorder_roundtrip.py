@@ -111,6 +111,26 @@ def test_metadata_v9_mcap(recording: dict[str, Any]) -> None:
     assert "collide_ros.params" in (meta.get("custom_data") or {})
 
 
+def test_metadata_ros_distro_jazzy(recording: dict[str, Any]) -> None:
+    """The bag says which ROS 2 release it is for (rosbags would write "rosbags"): in metadata.yaml,
+    as rosbags reads it, and in the MCAP file's rosbag2 metadata record (what `ros2 bag info` of
+    the bare .mcap file reads)."""
+    from mcap.reader import make_reader
+    from rosbags.rosbag2 import Reader
+
+    bag = recording["bag"]
+    meta = yaml.safe_load((bag / "metadata.yaml").read_text())["rosbag2_bagfile_information"]
+    assert meta["ros_distro"] == "jazzy"
+    with Reader(bag) as r:
+        assert r.ros_distro == "jazzy"
+    (mcap_file,) = list(bag.glob("*.mcap"))
+    with mcap_file.open("rb") as f:
+        records = {m.name: m.metadata for m in make_reader(f).iter_metadata()}
+    embedded = yaml.safe_load(records["rosbag2"]["serialized_metadata"])
+    assert embedded["ros_distro"] == "jazzy"
+    assert embedded["message_count"] == meta["message_count"]  # the rest as rosbags wrote it
+
+
 def test_counts_timestamps_decode(recording: dict[str, Any]) -> None:
     msgs, types = _read(recording["bag"])
     assert set(recording["printed"]) == set(msgs)
