@@ -317,3 +317,26 @@ def running_sim(*node_args: str) -> Iterator[tuple[SimClient, NodeProcess]]:
         code = proc.stop()
         rclpy.shutdown(context=ctx)
     assert code == 0, f"node exited with {code}; log:\n{proc.output()}"
+
+
+@contextmanager
+def sims_side_by_side(*node_args: tuple[str, ...]) -> Iterator[list[SimClient]]:
+    """One sim node per argument tuple (each with its own ``-r __ns:=/name``), in one rclpy context, a
+    SimClient for each namespace; yields the clients once every sim has published its states, and on
+    exit stops the nodes and asserts that each exited cleanly (status 0)."""
+    ctx = rclpy.Context()
+    rclpy.init(context=ctx)
+    procs = [NodeProcess(*args) for args in node_args]
+    spaces = [args[args.index("-r") + 1].split(":=", 1)[1] for args in node_args]
+    clients = [SimClient(ns, context=ctx) for ns in spaces]
+    try:
+        for c, p in zip(clients, procs):
+            assert c.wait_for(lambda c=c: c.count["bodies/states"] > 0, 60.0), p.output()
+        yield clients
+    finally:
+        for c in clients:
+            c.close()
+        codes = [p.stop() for p in procs]
+        rclpy.shutdown(context=ctx)
+    assert codes == [0] * len(procs), "".join(p.output() for p in procs)
+

@@ -14,28 +14,16 @@ from rosgraph_msgs.msg import Clock
 from std_srvs.srv import SetBool
 
 from collide_ros.cdr import join_time
-from collide_ros.testing import NodeProcess, SimClient
+from collide_ros.testing import NodeProcess, SimClient, sims_side_by_side
 
 
 @pytest.fixture(scope="module")
 def robots() -> Iterator[tuple[SimClient, SimClient]]:
-    ctx = rclpy.Context()
-    rclpy.init(context=ctx)
     # clock_rate 100 Hz: a Python subscriber keeps up, so every /clock message is seen in order
-    p1 = NodeProcess("-r", "__ns:=/robot1", "-p", "blocks:=1", "-p", "clock_rate:=100.0")
-    p2 = NodeProcess("-r", "__ns:=/robot2", "-p", "blocks:=2", "-p", "clock_rate:=100.0",
-                     "-p", "publish_clock:=false")
-    c1, c2 = SimClient("/robot1", context=ctx), SimClient("/robot2", context=ctx)
-    try:
-        for c, p in ((c1, p1), (c2, p2)):
-            assert c.wait_for(lambda: c.count["bodies/states"] > 0, 60.0), p.output()
+    with sims_side_by_side(("-r", "__ns:=/robot1", "-p", "blocks:=1", "-p", "clock_rate:=100.0"),
+                           ("-r", "__ns:=/robot2", "-p", "blocks:=2", "-p", "clock_rate:=100.0",
+                            "-p", "publish_clock:=false")) as (c1, c2):
         yield c1, c2
-    finally:
-        c1.close()
-        c2.close()
-        codes = (p1.stop(), p2.stop())
-        rclpy.shutdown(context=ctx)
-    assert codes == (0, 0), p1.output() + p2.output()
 
 
 def test_one_clock_that_never_jumps_back(robots: tuple[SimClient, SimClient]) -> None:

@@ -6,30 +6,17 @@ from __future__ import annotations
 from typing import Iterator
 
 import pytest
-import rclpy
 from geometry_msgs.msg import WrenchStamped
 from std_srvs.srv import SetBool
 
-from collide_ros.testing import NodeProcess, SimClient
+from collide_ros.testing import SimClient, sims_side_by_side
 
 
 @pytest.fixture(scope="module")
 def arenas() -> Iterator[tuple[SimClient, SimClient]]:
-    ctx = rclpy.Context()
-    rclpy.init(context=ctx)
-    p1 = NodeProcess("-r", "__ns:=/arena1", "-p", "blocks:=1", "-p", "command_timeout:=0.5")
-    p2 = NodeProcess("-r", "__ns:=/arena2", "-p", "blocks:=3", "-p", "command_timeout:=0.5")
-    c1, c2 = SimClient("/arena1", context=ctx), SimClient("/arena2", context=ctx)
-    try:
-        for c, p in ((c1, p1), (c2, p2)):
-            assert c.wait_for(lambda: c.count["bodies/states"] > 0, 60.0), p.output()
+    with sims_side_by_side(("-r", "__ns:=/arena1", "-p", "blocks:=1", "-p", "command_timeout:=0.5"),
+                           ("-r", "__ns:=/arena2", "-p", "blocks:=3", "-p", "command_timeout:=0.5")) as (c1, c2):
         yield c1, c2
-    finally:
-        c1.close()
-        c2.close()
-        codes = (p1.stop(), p2.stop())
-        rclpy.shutdown(context=ctx)
-    assert codes == (0, 0), p1.output() + p2.output()
 
 
 def test_each_namespace_has_its_own_world(arenas: tuple[SimClient, SimClient]) -> None:

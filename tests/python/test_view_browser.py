@@ -113,6 +113,14 @@ class Stack:
     def page_body(self, name: str) -> dict[str, Any] | None:
         return self.js(f"(window.__view && window.__view.bodies[{json.dumps(name)}]) || null")
 
+    def page_shows(self, want: dict[str, tuple[float, float]]) -> bool:
+        """Whether the page holds every named body at its (x, y), to 1e-9 m (the JSON carries doubles)."""
+        for n, (x, y) in want.items():
+            b = self.page_body(n)
+            if b is None or abs(b["x"] - x) > 1e-9 or abs(b["y"] - y) > 1e-9:
+                return False
+        return True
+
     def screen(self, x: float, y: float) -> tuple[float, float]:
         sx, sy = self.js(f"window.__view.toScreen({x!r}, {y!r})")
         return float(sx), float(sy)
@@ -132,13 +140,7 @@ class Stack:
             return True
         self.until(at_rest, "bodies/states of the reset scene")
 
-        def page_at_rest() -> bool:
-            for n, (x, y) in got.items():
-                b = self.page_body(n)
-                if b is None or abs(b["x"] - x) > 1e-9 or abs(b["y"] - y) > 1e-9:
-                    return False
-            return True
-        self.until(page_at_rest, "the page to show the reset scene")
+        self.until(lambda: self.page_shows(got), "the page to show the reset scene")
 
     def state(self, name: str) -> tuple[float, ...]:
         s = self.client.body_state(name)
@@ -189,13 +191,7 @@ def test_page_draws_bodies_where_poses_put_them(stack: Stack, tmp_path: Path) ->
     # gravity 0 and no command: the default scene rests, so every pose stays where it is
     want = {n: (p.position.x, p.position.y) for n, p in zip(names, poses.poses)}
 
-    def same() -> bool:
-        for n, (x, y) in want.items():
-            b = stack.page_body(n)
-            if b is None or abs(b["x"] - x) > 1e-9 or abs(b["y"] - y) > 1e-9:
-                return False
-        return True
-    stack.until(same, "the page's bodies at the poses of bodies/poses")
+    stack.until(lambda: stack.page_shows(want), "the page's bodies at the poses of bodies/poses")
     walls = [b for b in stack.js("Object.values(window.__view.bodies)") if b["static"]]
     assert len(walls) == 4, walls  # the default scene's box
     png = stack.page.screenshot()

@@ -48,7 +48,7 @@ LC_API lc_status lc_world_set_def(lc_world *world, const lc_world_def *def);
 LC_API lc_status lc_world_set_gravity(lc_world *world, lc_vec2 gravity);
 /* Sets linear damping k (N*s/m) and the rotation ratio r (m^2): force -k*v, torque -k*r*omega. */
 LC_API lc_status lc_world_set_damping(lc_world *world, double damping, double rotation_ratio);
-/* Sets the elasticity of every body present, as the seed's control does. */
+/* Sets the elasticity of every body present (a single control for the whole scene). */
 LC_API lc_status lc_world_set_elasticity(lc_world *world, double elasticity);
 /* Simulated time (s). */
 LC_API double lc_world_get_time(const lc_world *world);
@@ -110,8 +110,9 @@ LC_API lc_status lc_body_get_center_offset(const lc_world *world, lc_body_id id,
 
 /* Adds a thruster to a dynamic body; its index on that body goes to out_index (may be NULL). */
 LC_API lc_status lc_body_add_thruster(lc_world *world, lc_body_id id, const lc_thruster_def *def, int *out_index);
-/* Adds the seed's four keyboard thrusters sized for a w x h block (see docs): 0 = left (S/J),
- * 1 = right (F/L), 2 = up (E/I), 3 = down (D/K); side thrusters act above the centre and turn it. */
+/* Adds four keyboard thrusters sized for a w x h block (myPhysicsLab's layout, docs/physics.md):
+ * 0 = left (S/J), 1 = right (F/L), 2 = up (E/I), 3 = down (D/K); side thrusters act above the centre
+ * and turn it. */
 LC_API lc_status lc_body_add_default_thrusters(lc_world *world, lc_body_id id, double thrust, int *out_first_index);
 /* Sets a thruster's level in [0, 1] (0 = off, 1 = full magnitude). */
 LC_API lc_status lc_body_set_thruster_level(lc_world *world, lc_body_id id, int index, double level);

@@ -41,7 +41,7 @@ typedef enum lc_status {
 typedef enum lc_integrator {
     LC_INTEGRATOR_EULER = 1,    /* explicit Euler, order 1 (for teaching and order tests) */
     LC_INTEGRATOR_MIDPOINT = 2, /* explicit midpoint, order 2 */
-    LC_INTEGRATOR_RK4 = 4       /* classic Runge-Kutta, order 4 (default, as the seed) */
+    LC_INTEGRATOR_RK4 = 4       /* classic Runge-Kutta, order 4 (default) */
 } lc_integrator;
 
 /* How simultaneous impacts are resolved. */
@@ -53,7 +53,7 @@ typedef enum lc_impact_mode {
 /* How the time of impact is found once a step has penetrated. */
 typedef enum lc_toi_method {
     LC_TOI_ROOT_FINDER = 0,     /* bracketed root finder on the gap function (default) */
-    LC_TOI_BINARY_SEARCH = 1    /* the seed's bisection */
+    LC_TOI_BINARY_SEARCH = 1    /* bisection on the time of impact */
 } lc_toi_method;
 
 /* Broadphase pair finding. */
@@ -65,7 +65,7 @@ typedef enum lc_broadphase {
 
 /* How two bodies' coefficients combine for a contact. */
 typedef enum lc_mix_rule {
-    LC_MIX_MIN = 0,       /* min(a, b): the seed's rule for elasticity (default for elasticity) */
+    LC_MIX_MIN = 0,       /* min(a, b) (default for elasticity) */
     LC_MIX_MAX = 1,
     LC_MIX_MEAN = 2,      /* (a + b) / 2 */
     LC_MIX_GEOMETRIC = 3  /* sqrt(a * b): default for friction */
@@ -167,7 +167,7 @@ typedef struct lc_spring_def {
     lc_vec2 point_a;    /* m, body_a local frame */
     lc_body_id body_b;  /* a body, or LC_WORLD_ANCHOR */
     lc_vec2 point_b;    /* m, body_b local frame, or world frame when body_b is LC_WORLD_ANCHOR */
-    double stiffness;   /* N/m, [0, 1e9], default 3 (the seed's mouse spring) */
+    double stiffness;   /* N/m, [0, 1e9], default 3 (a mouse spring's) */
     double damping;     /* N*s/m on the relative velocity of the two points, [0, 1e9], default 0 */
     double rest_length; /* m, [0, 1e6], default 0 */
 } lc_spring_def;
@@ -203,7 +203,7 @@ typedef struct lc_contact {
     lc_contact_kind kind;
 } lc_contact;
 
-/* Energy split as on the seed's bar graph, plus momentum. */
+/* Energy split into translational, rotational, gravitational and spring parts, plus momentum. */
 typedef struct lc_energy {
     double translational;    /* J, sum of m|v|^2/2 */
     double rotational;       /* J, sum of I*omega^2/2 */

@@ -63,7 +63,9 @@ class ViewBridge(Node):
         self._held: dict[int, frozenset[str]] = {}   # client -> thruster keys held
         self._active: set[int] = set()               # block slots firing now
         self._springs: dict[int, str] = {}            # client -> spring name in use
-        self._diag_name = f"{sim}: physics"
+        # the sim names its /diagnostics status by its fully qualified name (/sim, /robot1/sim): the one
+        # in this view's namespace, so a view beside several sims shows its own sim's health
+        self._diag_name = f"{self.get_namespace().rstrip('/')}/{sim}: physics"
         self.create_subscription(BodyStates, "bodies/states", self._on_states, LATEST)
         self.create_subscription(MarkerArray, "markers", self._on_markers, LATCHED)
         self.create_subscription(Contacts, "contacts", self._on_contacts, LATEST)
