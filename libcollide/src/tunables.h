@@ -101,9 +101,9 @@
 #define LC_CONTACT_SLIP_SPEED 1e-6
 /* m/s, the same for an island of several bodies (its first, not its precise, solve): there the points
  * of a settling pile slip to and fro at ~1 mm/s, and friction held to one side of its cone lets every
- * point that reverses within a step slide freely; such a pile never came to rest. Below this the whole
- * cone acts; the work that can do beyond the one-sided rule (at most mu lambda_n times this per point)
- * is what the energy guard takes back from the island's motion (contact_regime.c). */
+ * point that reverses within a step slide freely, so the pile does not come to rest. Below this the
+ * whole cone acts; the work that can do beyond the one-sided rule (at most mu lambda_n times this per
+ * point) is what the energy guard takes back from the island's motion (contact_regime.c). */
 #define LC_CONTACT_PILE_SLIP_SPEED 1e-3
 /* A solve of m points fewer than this may take contact_iterations x this / m sweeps: the work of one of
  * this size. A few bodies whose friction and normal impulses trade through their rotation need 40-60
@@ -126,8 +126,8 @@
  * energy gain above the allowances below are taken again in the event regime, exact at that size. A
  * larger island keeps the precise step and counts it (lc_counters contact_unresolved): the event
  * regime's cost grows with the cube of an island's contacts at each micro-impact (a base-12 pyramid
- * hit by a box: seconds for one step), and the gain such a step keeps is what its stalled solve left,
- * ~1e-7 of the island's energy in that pyramid. */
+ * hit by a box: seconds for one step), and the gain such a step keeps is what its precise solve left,
+ * ~1e-10 of the island's energy in that pyramid (bench/contact.py's drop12). */
 #define LC_CONTACT_EVENT_FALLBACK_BODIES 8
 /* Sweeps over which a contact solve's largest change must halve, or the solve stops as stalled (a
  * precise retry runs its sweeps out). */
