@@ -41,6 +41,7 @@ import collide
 from collide import CollideError
 
 from collide_ros import cdr, markers, params, qos
+from collide_ros.diag_name import physics_status
 
 WARN_PERIOD = 1.0  # s (wall) between two warnings with the same key
 MAX_STEPS_PER_CALL = 1_000_000  # ~/step upper bound per request
@@ -1072,7 +1073,7 @@ class SimNode(Node):
         n = max(self._window_steps, 1)
         target = float(self._p["real_time_factor"])
         st = DiagnosticStatus()
-        st.name = f"{self.get_fully_qualified_name()}: physics"  # /robot1/sim: physics, /sim: physics
+        st.name = physics_status(self.get_fully_qualified_name())
         st.hardware_id = "libcollide " + collide.version()
         slow = target > 0 and not self._paused and self.last_rtf < 0.9 * target
         st.level = DiagnosticStatus.WARN if slow else DiagnosticStatus.OK

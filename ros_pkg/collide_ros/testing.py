@@ -31,6 +31,7 @@ from tf2_msgs.msg import TFMessage
 from visualization_msgs.msg import MarkerArray
 
 from .cdr import join_time
+from .diag_name import physics_status
 
 REPO = Path(__file__).resolve().parents[2]
 
@@ -83,7 +84,7 @@ def diag_values(msg: Any, name: str = "/sim") -> dict[str, str] | None:
     """The values of the ``<name>: physics`` status of a DiagnosticArray (None if it has none);
     ``name`` is the node's fully qualified name (``/sim``, ``/robot1/sim``)."""
     for st in msg.status:
-        if st.name == f"{name}: physics":
+        if st.name == physics_status(name):
             return {kv.key: kv.value for kv in st.values}
     return None
 

@@ -23,6 +23,7 @@ from visualization_msgs.msg import MarkerArray
 
 from collide_ros import qos
 from collide_ros.cdr import join_time
+from collide_ros.diag_name import physics_status, sim_node_name
 from collide_ros.teleop import N_THRUSTERS, firing_for
 from collide_ros.view.protocol import PARAMS
 from collide_ros.view.scene import SceneState, yaw_of
@@ -65,7 +66,7 @@ class ViewBridge(Node):
         self._springs: dict[int, str] = {}            # client -> spring name in use
         # the sim names its /diagnostics status by its fully qualified name (/sim, /robot1/sim): the one
         # in this view's namespace, so a view beside several sims shows its own sim's health
-        self._diag_name = f"{self.get_namespace().rstrip('/')}/{sim}: physics"
+        self._diag_name = physics_status(sim_node_name(self.get_namespace(), sim))
         self.create_subscription(BodyStates, "bodies/states", self._on_states, LATEST)
         self.create_subscription(MarkerArray, "markers", self._on_markers, LATCHED)
         self.create_subscription(Contacts, "contacts", self._on_contacts, LATEST)
