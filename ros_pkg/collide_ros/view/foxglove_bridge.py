@@ -4,7 +4,8 @@ the page (``python -m collide_ros.view --foxglove``).
 Channels, under the view's namespace (``/robot1/scene`` for a view started with ``-r __ns:=/robot1``):
 
 - ``/scene`` (foxglove.SceneUpdate, protobuf): one entity per body, ``body/<name>`` for the dynamic
-  bodies and ``static/<id>`` for the walls, each a filled polygon (the node's marker colour, block1
+  bodies and ``static/<id>`` for the walls (``shape/<id>`` for a body the view has not named yet:
+  more than UNNAMED_WAIT after its shapes came), each a filled polygon (the node's marker colour, block1
   green) with a dark outline, at its pose in the world frame; ``contacts`` (red spheres at the contact
   points) and ``springs`` (orange lines). Every message carries the whole scene; entities that went
   (a body killed, a reset with fewer bodies) are deleted by id.
@@ -31,6 +32,7 @@ from collide_ros.view import foxglove_wire as wire
 from collide_ros.view.bridge import ViewBridge
 
 HEARTBEAT = 1.0  # s: a message at least this often, even when nothing changed
+UNNAMED_WAIT = 1.0  # s: how long the scene waits for the view to name the bodies of new shapes
 ENERGY_KEYS = ("translational", "rotational", "potential", "gravitational", "spring", "total", "start")
 ENERGY_SCHEMA: dict[str, Any] = {
     "type": "object", "title": "libcollide energy (J)",
@@ -73,6 +75,7 @@ class FoxgloveStream:
         self._children: list[bytes] = []     # ... and their frames, encoded
         self._frames: tuple[str, str] | None = None
         self._named = False                  # the dynamic bodies among the shapes are known
+        self._shapes_at = 0.0                # when the shapes last changed (monotonic s)
         self._sent_ids: set[str] = set()     # entity ids of the last scene sent
         self.sent = 0                        # scene messages logged
 
@@ -109,13 +112,15 @@ class FoxgloveStream:
         if version == self._version and frames == self._frames:
             return True
         shapes = self.bridge.shapes()
+        if shapes["version"] != self._version:
+            self._shapes_at = time.monotonic()
         self._version, self._frames = shapes["version"], frames
         self._parts, self._ids, self._dynamic, self._names = [], [], [], []
-        # right after the shapes change the view does not know yet which are the dynamic bodies (it
-        # matches them with bodies/states): no entity ids before then, so none flicker
         self._named = all(b["name"] or b["static"] for b in shapes["bodies"])
         for i, b in enumerate(shapes["bodies"]):
-            eid = f"body/{b['name']}" if b["name"] else f"static/{b['id']}"
+            # a shape the view has not named yet (matched with bodies/states) is shape/<marker id>
+            eid = (f"body/{b['name']}" if b["name"] else f"static/{b['id']}" if b["static"]
+                   else f"shape/{b['id']}")
             self._ids.append(eid)
             self._parts.append(wire.body_parts(eid, b["verts"], wire.hex_rgba(b["color"])))
             if b["name"]:
@@ -128,8 +133,10 @@ class FoxgloveStream:
         """Log one frame of the view's state (a ``snapshot()`` state message) on the channels."""
         if not self._refresh(state["version"]):
             return  # the frames' names first (the node's parameters)
-        if len(state["poses"]) != len(self._parts) or (not self._named and state["velocities"]):
-            return  # the shapes changed since the snapshot, or are not named yet: a later frame
+        if len(state["poses"]) != len(self._parts):
+            return  # the shapes changed since the snapshot: the next frame has both
+        if not self._named and state["velocities"] and time.monotonic() - self._shapes_at < UNNAMED_WAIT:
+            return  # right after the shapes change: names first, so that no entity id flickers
         assert self._frames is not None
         world = self._frames[0]
         stamp = wire.timestamp(state["t"])
