@@ -527,24 +527,28 @@ static int island_driven(const island_ctx *c)
 
 /* The projection by MPRGP (sparse_lcp.c, conjugate gradients with bound projections), when Gauss-Seidel
  * did not converge: it needs sweeps in the square of a chain's length (a block pushing a row of twenty
- * boxes left the row overlapping after 400), MPRGP products in its length. The displacements land in
- * b.disp. */
-static int project_by_mprgp(island_ctx *c, const lc_touch *t, int nt, double gp, lc_contact_row *rows)
+ * boxes left the row overlapping after 400), MPRGP products in its length. left: the deepest overlap the
+ * pass starts from. A pass of at least LC_CONTACT_PROJECTION_LARGE points starts from the sweeps' answer
+ * (in rows) and stops near the overlap it starts from (tunables.h); a smaller one starts from zero and
+ * solves to LC_CONTACT_PROJECTION_SLACK. The displacements land in b.disp. */
+static int project_by_mprgp(island_ctx *c, const lc_touch *t, int nt, double gp, double left, lc_contact_row *rows)
 {
     lc_world *w = c->w;
-    double *v = lc_buf_get(&c->cr->b_mprgp, (size_t)nt * 4 * sizeof(double)), *b, *lo, *hi, viol;
-    int i;
+    double *v = lc_buf_get(&c->cr->b_mprgp, (size_t)nt * 4 * sizeof(double)), *b, *lo, *hi, viol, tol;
+    int i, large = nt >= LC_CONTACT_PROJECTION_LARGE;
     if (v == NULL) return -1;
     b = v + nt;
     lo = b + nt;
     hi = lo + nt;
     for (i = 0; i < nt; ++i) {
-        v[i] = 0.0;
+        v[i] = large ? rows[i].lambda_n : 0.0;
         b[i] = t[i].gap - gp;
         lo[i] = 0.0;
         hi[i] = INFINITY;
     }
-    if (lc_sparse_lcp(w, t, nt, 0, b, lo, hi, v, LC_CONTACT_PROJECTION_SLACK, LC_CONTACT_PROJECTION_PRODUCTS, &viol) < 0) return -1;
+    tol = large ? fmax(LC_CONTACT_PROJECTION_SLACK, LC_CONTACT_PROJECTION_PASS_TOLERANCE * left)
+                : LC_CONTACT_PROJECTION_SLACK;
+    if (lc_sparse_lcp(w, t, nt, 0, b, lo, hi, v, tol, LC_CONTACT_PROJECTION_PRODUCTS, &viol) < 0) return -1;
     for (i = 0; i < nt; ++i)
         if (v[i] > 0.0 && isfinite(v[i])) lc_contact_row_apply(&rows[i], v[i], 0.0, c->b.disp, c->b.inv_mass, c->b.inv_inertia);
     return 0;
@@ -601,7 +605,7 @@ static int project(island_ctx *c, double *left)
         /* a pass that cut the overlap a hundredfold is kept: the next pass starts from there */
         if (ps.residual > LC_CONTACT_PROJECTION_SLACK && ps.residual > LC_CONTACT_PROJECTION_GAIN * *left) {
             memset(c->b.disp, 0, (size_t)c->b.n * 3 * sizeof(double));
-            if (project_by_mprgp(c, t, nt, gp, rows) != 0) return -1;
+            if (project_by_mprgp(c, t, nt, gp, *left, rows) != 0) return -1;
         }
         for (i = 0; i < c->b.n; ++i) {
             double *s = &w->state[c->isl->rows[i] * 6];

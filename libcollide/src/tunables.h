@@ -163,6 +163,18 @@
 #define LC_CONTACT_PROJECTION_GAIN 1e-2
 #endif
 #define LC_CONTACT_PROJECTION_PRODUCTS 2000
+/* A projection pass of at least LC_CONTACT_PROJECTION_LARGE points that Gauss-Seidel did not converge
+ * starts MPRGP from the sweeps' answer and stops it within LC_CONTACT_PROJECTION_PASS_TOLERANCE of the
+ * overlap the pass starts from (or at LC_CONTACT_PROJECTION_SLACK, the larger): the linearised gaps a
+ * pass solves are off by the rotation's second-order remainder, ~overlap^2 / size (3e-3 of a
+ * millimetre's overlap on a 0.3 m box), which the next pass removes together with the solve's own
+ * error. A settling 1 000-box pile ends its flow a millimetre deep every step (Gauss-Seidel stalls in
+ * its 25 layers); its passes took the 2 000-product budget and 600 more to reach 4e-10 m from zero.
+ * Smaller passes start from zero and keep the absolute stop: their products are cheap, and either
+ * change moved which steps of a box dropped on a base-12 pyramid needed their precise retry, one of
+ * them then keeping a gain above 1e-9 of the energy (bench/contact.py drop12). */
+#define LC_CONTACT_PROJECTION_PASS_TOLERANCE 1e-3
+#define LC_CONTACT_PROJECTION_LARGE 1000
 
 /* ---- contact forces and impulses (contact_forces.c, impulse.c) ---------------------------------- */
 
