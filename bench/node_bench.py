@@ -66,7 +66,6 @@ import yaml
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "ros_pkg"))
-sys.path.insert(0, str(ROOT / "tests" / "python"))
 
 DEFAULT_CASES = ("6", "1000", "pile200", "pile200@0.005")
 
@@ -74,7 +73,7 @@ DEFAULT_CASES = ("6", "1000", "pile200", "pile200@0.005")
 def pick_domain() -> object | None:
     if "ROS_DOMAIN_ID" in os.environ:
         return None
-    import ros_domain
+    from collide_ros import ros_domain
     lock = ros_domain.acquire(range(75, 80))
     os.environ["ROS_DOMAIN_ID"] = str(lock.domain_id)
     return lock

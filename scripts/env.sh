@@ -2,7 +2,7 @@
 # Source me (bash):  source scripts/env.sh
 # Activates the project venv (.venv, made by scripts/setup) and sets everything a ROS 2 process
 # of this project needs. Safe to source more than once and under `set -euo pipefail`.
-# It does not set ROS_DOMAIN_ID: tests allocate their own (tests/python/ros_domain.py),
+# It does not set ROS_DOMAIN_ID: tests allocate their own (collide_ros/ros_domain.py),
 # scripts/demo picks a free one when you have not exported one yourself.
 
 _lc_env_dir="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"

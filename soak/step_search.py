@@ -117,7 +117,7 @@ def run_node(seed: int, steps: int) -> SeedResult:
 
 
 class EngineClient:
-    """The node's command semantics on a bare World (collide_ros/node.py, _on_* and _apply_forces):
+    """The node's command semantics on a bare World (collide_ros/sim/commands.py and forces.py):
     the client that soak.soak.Driver publishes its random commands to, so both modes draw the
     soak's own mix."""
 

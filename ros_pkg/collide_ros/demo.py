@@ -25,7 +25,6 @@ import math
 import os
 import shutil
 import signal
-import socket
 import subprocess
 import sys
 import threading
@@ -34,6 +33,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from . import ros_domain
 from .cdr import join_time
 from .teleop import LEFT, RIGHT, UP
 
@@ -46,28 +46,6 @@ COMMAND_TOPICS = ["thrusters", "spring", "block1/thrust", "block2/thrust", "cmd_
 ECHO_TOPICS = ["applied/" + t for t in COMMAND_TOPICS]
 #: the demo's node parameters (everything else at the node's defaults)
 NODE_PARAMS = {"clock_rate": 100.0, "state_rate": 100.0, "cmd_vel_body": "block2"}
-
-
-# ------------------------------------------------------------------ ROS_DOMAIN_ID
-
-def lock_domain() -> socket.socket | None:
-    """Lock a free ROS_DOMAIN_ID (TCP port 32768+id on loopback, as ament's domain_coordinator
-    and tests/python/ros_domain.py do) and export it, unless ROS_DOMAIN_ID is already set.
-    Ids 1..101 without 50..79 (the team's hand-run ranges). Returns the socket to keep."""
-    if os.environ.get("ROS_DOMAIN_ID"):
-        return None
-    ids = [i for i in range(1, 102) if not 50 <= i < 80]
-    start = os.getpid() % len(ids)
-    for i in ids[start:] + ids[:start]:
-        s = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
-        try:
-            s.bind(("127.0.0.1", 32768 + i))
-        except OSError:
-            s.close()
-            continue
-        os.environ["ROS_DOMAIN_ID"] = str(i)
-        return s
-    raise RuntimeError("no free ROS_DOMAIN_ID")
 
 
 # ------------------------------------------------------------------ the script
@@ -355,7 +333,7 @@ def run(out: Path, duration: float, gif: bool, do_replay: bool, view: bool = Tru
     gif_path = out / "demo.gif"
     os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
     os.environ.pop("ROS_LOCALHOST_ONLY", None)
-    lock = lock_domain()
+    lock = ros_domain.lock_unless_set()
     print(f"demo: ROS_DOMAIN_ID={os.environ['ROS_DOMAIN_ID']}, discovery LOCALHOST; logs in {out}/",
           flush=True)
 
@@ -420,7 +398,7 @@ def run(out: Path, duration: float, gif: bool, do_replay: bool, view: bool = Tru
         rclpy.try_shutdown()
         node.stop()
         if lock is not None:
-            lock.close()
+            lock.release()
     wall = time.monotonic() - wall0
     if rc_rec != 0:
         print(f"demo: recorder failed ({rc_rec}); see {out / 'demo_recorder.log'}", file=sys.stderr)
@@ -438,14 +416,14 @@ def run(out: Path, duration: float, gif: bool, do_replay: bool, view: bool = Tru
     if do_replay:
         from .replay import replay
         rclpy.init(args=[])
-        lock = lock_domain() if "ROS_DOMAIN_ID" not in os.environ else None
+        lock = ros_domain.lock_unless_set()
         try:
             with (out / "demo_replay_node.log").open("w") as log:
                 summ["replay"] = replay(bag, log=log)
         finally:
             rclpy.try_shutdown()
             if lock is not None:
-                lock.close()
+                lock.release()
     (out / "demo_summary.json").write_text(json.dumps(summ, indent=2, default=str))
     print_summary(summ, counts_txt)
     return 0 if not do_replay or summ["replay"]["ok"] else 1

@@ -1,0 +1,173 @@
+"""What the node publishes at rates counted in sim-time steps: bodies/poses, bodies/states, contacts and
+energy (state_rate), /tf, markers and /clock. The bulk messages are written as CDR bytes with numpy
+(cdr.py, markers.py); the impacts of every step are kept until the next contacts message."""
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from builtin_interfaces.msg import Time
+from geometry_msgs.msg import PoseArray, Vector3
+from libcollide_msgs.msg import BodyStates, Contacts, Energy
+from rosgraph_msgs.msg import Clock
+from tf2_msgs.msg import TFMessage
+from visualization_msgs.msg import MarkerArray
+
+import collide
+
+from collide_ros import cdr, markers, qos
+
+# Contacts per contacts message (impacts since the last one first, then resting contacts); more
+# are dropped and counted (dropped_contacts). A reliable writer's history keeps every slot's
+# largest message (Fast DDS reallocates a slot's buffer upwards, never down), so the node's memory
+# grows towards state_qos_depth x the largest contacts message: 1000 contacts (~74 kB) x 100 =
+# ~7 MB. Uncapped, the soak saw 100 000 impacts (7.4 MB) in one message and the RSS grew by 94 MiB
+# in an hour (docs/hardening.md, "Soak").
+MAX_CONTACTS_PER_MESSAGE = 1000
+
+
+def hex_color(value: Any, fallback: markers.Color) -> markers.Color:
+    """A scene's '#rrggbb' colour as RGBA, or ``fallback``."""
+    if isinstance(value, str) and value.startswith("#") and len(value) == 7:
+        try:
+            return (int(value[1:3], 16) / 255.0, int(value[3:5], 16) / 255.0, int(value[5:7], 16) / 255.0, 1.0)
+        except ValueError:
+            return fallback
+    return fallback
+
+
+def concat_rows(parts: list[np.ndarray]) -> np.ndarray:
+    """np.concatenate of structured rows, copied as opaque records when all have one dtype: numpy
+    copies a structured dtype with padding (lc_contact's) field by field into a packed dtype, several
+    times slower; this keeps the dtype."""
+    dtype = parts[0].dtype
+    if any(p.dtype != dtype for p in parts):
+        return np.concatenate(parts)
+    record = np.dtype((np.void, dtype.itemsize))
+    return np.concatenate([p.view(record) for p in parts]).view(dtype)
+
+
+class Publishing:
+    """Owns the publishers of the state topics (``_pub_poses``, ``_pub_states``, ``_pub_contacts``,
+    ``_pub_energy``, ``_pub_clock`` (None with publish_clock false), ``_pub_tf``, ``_pub_markers``), their
+    CDR writers (``_cdr_*``), the publish periods in steps (``_every_*``) and the impacts kept for the next
+    contacts message (``_pending``, ``_pending_count``, ``dropped_contacts``)."""
+
+    def _init_publishing(self) -> None:
+        state_qos = qos.state(int(self._p["state_qos_depth"]))
+        self._pub_poses = self._publisher(PoseArray, "bodies/poses", state_qos)
+        self._pub_states = self._publisher(BodyStates, "bodies/states", state_qos)
+        self._pub_contacts = self._publisher(Contacts, "contacts", state_qos)
+        self._pub_energy = self._publisher(Energy, "energy", state_qos)
+        # one /clock per domain: a sim beside the clock owner leaves it out (publish_clock, read-only)
+        self._pub_clock = self._publisher(Clock, "/clock", qos.CLOCK) if self._p["publish_clock"] else None
+        self._pub_tf = self._publisher(TFMessage, "/tf", qos.TF)
+        self._pub_markers = self._publisher(MarkerArray, "markers", qos.MARKERS)
+        self._pending: list[np.ndarray] = []
+        self._pending_count = 0
+        self.dropped_contacts = 0  # beyond MAX_CONTACTS_PER_MESSAGE, since the start
+
+    def _periods(self) -> None:
+        dt = float(self._p["time_step"])
+
+        def every(rate: float) -> int:
+            return 0 if rate <= 0 else max(1, int(round(1.0 / (rate * dt))))
+        self._every_state = every(self._p["state_rate"])
+        self._every_tf = every(self._p["tf_rate"])
+        self._every_marker = every(self._p["marker_rate"])
+        self._every_clock = every(self._p["clock_rate"])
+
+    def _make_writers(self) -> None:
+        """The CDR writers for the current body set and frames."""
+        frame = self._p["world_frame"]
+        self._cdr_poses = cdr.PoseArrayCdr(len(self._dyn_rows), frame)
+        self._cdr_states = cdr.BodyStatesCdr(self._dyn_names, frame)
+        prefix = self._p["frame_prefix"]
+        self._cdr_tf = cdr.TFMessageCdr(frame, [prefix + n for n in self._dyn_names])
+        self._cdr_contacts = cdr.ContactsCdr(frame, self._name_of_id)
+        outlines, colors = [], []
+        for i, n in enumerate(self._names):
+            outlines.append(self._bodies[n].local_vertices())
+            colors.append(hex_color(self._colors.get(n), markers.body_color(n, i, bool(self._static[i]))))
+        ids = [int(i) for i in self._ids]
+        self._cdr_markers = markers.MarkerArrayCdr(frame, ids, outlines, colors)
+        # DELETEALL heads the new scene's message: sent on its own, the depth-1 history could replace it
+        # with the scene before a subscriber (RViz, the live view) took it
+        self._cdr_markers_reset = markers.MarkerArrayCdr(frame, ids, outlines, colors, lead=[markers.DELETE_ALL])
+
+    def _publish_due(self, s: int) -> None:
+        """What is due after step ``s`` (counted since the last build)."""
+        if self._pub_clock is not None and self._every_clock and s % self._every_clock == 0:
+            sec, ns = cdr.split_time(self.sim_time)
+            self._pub_clock.publish(cdr.clock_cdr(sec, ns))
+        if s % self._every_state == 0:
+            self._publish_state()
+        if self._every_tf and s % self._every_tf == 0:
+            self._publish_tf()
+        if self._every_marker and s % self._every_marker == 0:
+            self._publish_markers()
+
+    def _stamp(self) -> tuple[int, int]:
+        return cdr.split_time(self.sim_time)
+
+    def _publish_state(self) -> None:
+        sec, ns = self._stamp()
+        st = self.world.state[self._dyn_rows]
+        poses = cdr.poses_from_state(st)
+        self._pub_poses.publish(self._cdr_poses.encode(sec, ns, poses))
+        self._pub_states.publish(self._cdr_states.encode(sec, ns, poses, cdr.twists_from_state(st)))
+        stamp = Time(sec=sec, nanosec=ns)
+        frame = self._p["world_frame"]
+        e = self.world.energy
+        em = Energy()
+        em.header.stamp = stamp
+        em.header.frame_id = frame
+        em.translational, em.rotational = float(e.translational), float(e.rotational)
+        em.gravitational, em.spring, em.total = float(e.gravitational), float(e.spring), float(e.total)
+        em.linear_momentum = Vector3(x=float(e.linear_momentum[0]), y=float(e.linear_momentum[1]), z=0.0)
+        em.angular_momentum = float(e.angular_momentum)
+        self._pub_energy.publish(em)
+        self._pub_contacts.publish(self._cdr_contacts.encode(sec, ns, self._take_contacts()))
+
+    def _collect_collisions(self) -> None:
+        """Keep the impacts of every step until the next contacts publish (they last one step)."""
+        c = self.world.contacts
+        if len(c):
+            hits = c[c["kind"] == collide.COLLISION]
+            room = MAX_CONTACTS_PER_MESSAGE - self._pending_count
+            if len(hits) > room:
+                self.dropped_contacts += len(hits) - room
+                hits = hits[:room]
+            if len(hits):
+                self._pending.append(hits.copy())
+                self._pending_count += len(hits)
+
+    def _take_contacts(self) -> np.ndarray:
+        """Impacts since the last publish, then the resting contacts of the current step (at most
+        MAX_CONTACTS_PER_MESSAGE in all)."""
+        c = self.world.contacts
+        resting = c[c["kind"] != collide.COLLISION]
+        room = MAX_CONTACTS_PER_MESSAGE - self._pending_count
+        if len(resting) > room:
+            self.dropped_contacts += len(resting) - room
+            resting = resting[:room]
+        parts = [*self._pending, resting]
+        self._pending = []
+        self._pending_count = 0
+        return concat_rows(parts) if len(parts) > 1 else resting.copy()
+
+    def _publish_tf(self) -> None:
+        sec, ns = self._stamp()
+        st = self.world.state[self._dyn_rows]
+        self._pub_tf.publish(self._cdr_tf.encode(sec, ns, cdr.poses_from_state(st)))
+
+    def _publish_markers(self, reset: bool = False) -> None:
+        """The bodies, springs and contacts; ``reset``: headed by a DELETEALL (a new scene)."""
+        sec, ns = self._stamp()
+        poses = cdr.poses_from_state(self.world.state)
+        ends = [(np.asarray(a), np.asarray(b)) for a, b in (e.spring.endpoints() for e in self._springs.values())]
+        extras = markers.spring_markers(ends)
+        c = self.world.contacts
+        extras += markers.contact_markers(np.array(c["point"]).reshape(-1, 2), np.array(c["normal"]).reshape(-1, 2))
+        template = self._cdr_markers_reset if reset else self._cdr_markers
+        self._pub_markers.publish(template.encode(sec, ns, poses, extras))
