@@ -13,13 +13,13 @@ import numpy as np
 
 from . import _convert as cv
 from ._ffi import CollideError, check, ffi, lib
-from ._views import COLLISION, CONTACT_DTYPE, RESTING, _view
+from ._views import COLLISION, CONTACT_DTYPE, EVENT_DTYPE, IMPACT_CONTACT, IMPACT_EVENT, RESTING, _view
 from .body import Body, BodyRef, Spring, Thruster, _Record, _vec
 from . import query as _query
 from .query import BodyDistance, RayHit
 
 __all__ = ["World", "Body", "Thruster", "Spring", "Energy", "CollideError", "CONTACT_DTYPE",
-           "COLLISION", "RESTING", "WALL_NAMES"]
+           "COLLISION", "RESTING", "EVENT_DTYPE", "IMPACT_EVENT", "IMPACT_CONTACT", "WALL_NAMES"]
 
 WALL_NAMES = ("wall_bottom", "wall_right", "wall_top", "wall_left")  # lc_world_add_walls order
 
@@ -318,6 +318,34 @@ class World:
         count = ffi.new("int *")
         check(self._w, lib.lc_world_get_contacts(self._w, out, count))
         return _view(self, out[0], (count[0],), CONTACT_DTYPE)
+
+    def read_events(self, max_count: int | None = None) -> tuple[np.ndarray, int]:
+        """The impacts of the steps since the last read, oldest first, removed from the stream
+        (lc_world_get_events): (events, dropped). events is an EVENT_DTYPE array (a copy) of at most
+        max_count rows (None: all unread); dropped counts the oldest events the stream let go since the
+        last read because more than the world's event_capacity were unread."""
+        pending = ffi.new("int *")
+        dropped = ffi.new("uint64_t *")
+        if max_count is None:
+            check(self._w, lib.lc_world_get_events(self._w, ffi.NULL, 0, pending, ffi.NULL))
+            cap = pending[0]
+        else:
+            cap = cv.integer(max_count, "max_count")
+            if not 0 <= cap < 2**31:
+                raise ValueError(f"max_count must be in [0, 2**31), got {cap}")
+        out = np.zeros(cap, dtype=EVENT_DTYPE)
+        if cap == 0:  # nothing to read: the C call with capacity 0 is a size query and clears nothing
+            return out, 0
+        check(self._w, lib.lc_world_get_events(self._w, ffi.cast("lc_impact_event *", ffi.from_buffer(out)), cap,
+                                               pending, dropped))
+        return out[: pending[0]], int(dropped[0])
+
+    @property
+    def pending_events(self) -> int:
+        """Unread impact events (read_events returns them)."""
+        pending = ffi.new("int *")
+        check(self._w, lib.lc_world_get_events(self._w, ffi.NULL, 0, pending, ffi.NULL))
+        return int(pending[0])
 
     @property
     def energy(self) -> Energy:
