@@ -197,7 +197,7 @@ void lc_kept_touches_save(const lc_kept_touches *k, const lc_world *w, lc_writer
 int lc_kept_touches_load(lc_kept_touches *k, const lc_world *w, lc_reader *in)
 {
     arena *x = &k->a[1 - k->read];
-    int nrec = lc_get_count(in, 0, w->count, 28, "the kept touch sets"), r, i;
+    int nrec = lc_get_count(in, 0, 1 << 28, 32, "the kept touch sets"), r, i;
     arena_empty(x);
     for (r = 0; r < nrec && !in->bad; ++r) {
         int nrows = lc_get_count(in, 1, w->count, 52, "a kept set's rows");

@@ -302,8 +302,6 @@ static int get_body(lc_reader *in, lc_world *w, int i)
     flag = lc_get_u8(in);
     if (flag > 1) lc_reader_fail(in, "body %u's regime mark is %u", (unsigned)id, flag);
     w->rests_dissipative[i] = (uint8_t)flag;
-    if (!w->is_static[i] && !(w->mass[i] > 0.0 && w->inertia[i] > 0.0 && w->inv_mass[i] > 0.0 && w->inv_inertia[i] > 0.0))
-        lc_reader_fail(in, "dynamic body %u has no positive mass and inertia", (unsigned)id);
     memset(s, 0, sizeof *s);
     s->count = lc_get_count(in, 3, LC_MAX_POLYGON_VERTICES, 32, "a polygon's vertex count");
     for (k = 0; k < s->count; ++k) {

@@ -51,6 +51,6 @@ void lc_get_touch(lc_reader *in, const lc_world *w, lc_touch *t);
 /* A contact of a step's report (its numbers as written, its kind checked). */
 void lc_get_contact(lc_reader *in, lc_contact *c);
 /* Bytes a touch takes. */
-#define LC_TOUCH_BYTES (4 * 4 + 18 * 8)
+#define LC_TOUCH_BYTES (4 * 4 + 16 * 8)
 
 #endif

@@ -377,6 +377,48 @@ class World:
     def state_hash(self) -> int:
         return int(lib.lc_world_state_hash(self._w))
 
+    # ---- snapshots (lc_world_save / lc_world_load, docs/events_and_snapshots.md) -------------------
+    def save(self) -> bytes:
+        """A snapshot of the world: loaded into any World (load, from_snapshot), it steps on bit for bit
+        as this one does. Body and spring names are Python's and are not in it."""
+        size = ffi.new("size_t *")
+        check(self._w, lib.lc_world_save(self._w, ffi.NULL, 0, size))
+        buf = ffi.new("unsigned char[]", max(int(size[0]), 1))
+        check(self._w, lib.lc_world_save(self._w, buf, size[0], size))
+        return bytes(ffi.buffer(buf, size[0]))
+
+    def load(self, data: bytes | bytearray | memoryview) -> None:
+        """Replace everything in this world by a snapshot (save). A body id this world names keeps its
+        name, the others are named body<id>; unread impact events go. A truncated or corrupt snapshot
+        raises CollideError (LC_ERR_BAD_SNAPSHOT) and leaves the world as it was."""
+        if not isinstance(data, (bytes, bytearray, memoryview)):
+            raise TypeError(f"a snapshot is bytes, got {type(data).__name__}")
+        raw = bytes(data)
+        check(self._w, lib.lc_world_load(self._w, raw, len(raw)))
+        self._after_load()
+
+    @classmethod
+    def from_snapshot(cls, data: bytes | bytearray | memoryview) -> "World":
+        """A new World loaded from a snapshot (save); bodies are named body<id>."""
+        w = cls()
+        w.load(data)
+        return w
+
+    def _after_load(self) -> None:
+        old = {i: r.name for i, r in self._rec.items()}
+        self._rec, self._by_name = {}, {}
+        ids = [int(i) for i in self.ids]
+        for i in ids:  # the kept names first, so a default name cannot take one
+            if i in old:
+                self._rec[i] = _Record(old[i])
+                self._by_name[old[i]] = i
+        for i in ids:
+            if i not in self._rec:
+                self._register(i, None, sync=False)
+        self._sync_names()
+        self._springs = {n: s for n, s in self._springs.items() if self._spring_alive(s)}
+        self._poly_cache = None
+
     # ---- springs ---------------------------------------------------------------------------------
     def _spring_alive(self, spring_id: int) -> bool:
         d = ffi.new("lc_spring_def *")
