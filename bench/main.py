@@ -49,7 +49,7 @@ WP_VARIANTS: dict[str, list[tuple[str, dict, tuple[float, ...]]]] = {
                                      DTS[:1])],
 }
 # Trajectory reference (section "ref"): libcollide at its tightest TOI tolerances. Computed at dt 1/60
-# and at 1/960, seeds 1-3 (run of 2026-11-23 12:12, docs/benchmarks.md (1b)), it agrees with itself to
+# and at 1/960, seeds 1-3 (run of 2026-11-23 12:12, docs/benchmarks.md, trajectory error), it agrees with itself to
 # 2.6e-12 m over 0.5 s, but at 1 s one g = 9.8 seed is 1.7 m apart and by 2 s all are metres apart
 # (chaos), so REF_T = 0.5 s; the check runs to 2 s so that every run shows where the horizon stands.
 REF_T = 0.5
@@ -98,7 +98,7 @@ class Bench:
             if timed.get("status") == "ok" and st.get("time_step"):
                 r["stage_times"] = {k: st[k] / steps for k in st if k.startswith("time_")}
 
-    # ---- (1) seed scene: work-precision --------------------------------------------------------
+    # ---- seed scene: work-precision ------------------------------------------------------------
     def wp(self) -> None:
         seeds = (1,) if self.quick else (1, 2, 3)
         gs = (0.0, 9.8)
@@ -149,7 +149,7 @@ class Bench:
         out["n6"] = six
         self.out["wp"] = out
 
-    # ---- (1) seed scene: trajectory error against a converged reference ------------------------
+    # ---- seed scene: trajectory error against a converged reference ----------------------------
     def ref(self) -> None:
         """Each engine's trajectory against libcollide at its tightest TOI tolerances, over REF_T s of
         the seed scene. The scene is chaotic (every block-block impact amplifies a difference), so
@@ -174,7 +174,8 @@ class Bench:
             refs = {r["scene"]: r for r in res.values() if r["label"] == "reference" and r.get("status") == "ok"}
             checks = {r["scene"]: r for r in res.values() if r["label"] == "reference check"
                       and r.get("status") == "ok"}
-            # 10 s costs of the same settings from section (1), where it ran (its repeats are the timed ones)
+            # 10 s costs of the same settings from the work-precision section, where it ran (its repeats
+            # are the timed ones)
             wp_cost = {(r["label"], r["dt"]): r["cost"] for r in self.out.get("wp", {}).get(f"g{g:g}", [])}
             check = []
             for name, r in refs.items():
@@ -227,7 +228,7 @@ class Bench:
             rows.append({**strip(r), **m})
         self.out["impacts"] = rows
 
-    # ---- (5) Newton's cradle -------------------------------------------------------------------
+    # ---- Newton's cradle -----------------------------------------------------------------------
     def cradle(self) -> None:
         cases = [scenes.cradle(0.0), scenes.cradle(0.05)]
         tasks = [Task(eng, sc, 1 / 60, {}, None, self.budget) for sc in cases for eng in ALL]
@@ -241,7 +242,7 @@ class Bench:
             rows.append({**strip(r), **m})
         self.out["cradle"] = rows
 
-    # ---- (3) stacks ----------------------------------------------------------------------------
+    # ---- stacks --------------------------------------------------------------------------------
     def stacks(self) -> None:
         cases = [(scenes.stack(10), (1 / 60, 1 / 240)), (scenes.stack(10, e=1.0), (1 / 60,)),
                  (scenes.stack(20), (1 / 60, 1 / 240))]
@@ -267,7 +268,7 @@ class Bench:
             rows.append({**strip(r), **m})
         self.out["stacks"] = rows
 
-    # ---- (4) pyramid ----------------------------------------------------------------------------
+    # ---- pyramid --------------------------------------------------------------------------------
     def pyramid(self) -> None:
         bases = (5, 20) if self.quick else ((5, 20, 50, 100) if self.full else (5, 20, 50))
         rows = []
@@ -289,7 +290,7 @@ class Bench:
                     failed.add(r["engine"])
         self.out["pyramid"] = rows
 
-    # ---- (6) tunnelling -----------------------------------------------------------------------
+    # ---- tunnelling ---------------------------------------------------------------------------
     def tunnel(self) -> None:
         cases = [scenes.tunnel(v) for v in (10.0, 50.0, 200.0)]
         tasks = [Task(eng, sc, 1 / 60, {}, 1 / 60, self.budget) for sc in cases for eng in ALL]
@@ -302,7 +303,7 @@ class Bench:
             rows.append({**strip(r), **m})
         self.out["tunnel"] = rows
 
-    # ---- (2), (7), (8), (10): hard cases -------------------------------------------------------
+    # ---- hard cases: settling, mass ratio, wedged block, smash ----------------------------------
     def hard(self) -> None:
         cases = [scenes.settling(), scenes.mass_ratio_stack(), scenes.wedged(), scenes.smash()]
         if self.quick:

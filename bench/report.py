@@ -61,7 +61,7 @@ def _plt() -> Any:
 
 def plot_wp(rows: list[dict[str, Any]], title: str, path: str, key: str = "abs_drift",
             ylabel: str = "|relative energy drift| after 10 s (median of seeds)",
-            target: tuple[float, str] | None = (1e-9, "issue 4 target 1e-9")) -> None:
+            target: tuple[float, str] | None = (1e-9, "target 1e-9")) -> None:
     """Error (rows[key]) against cost, one line per engine over dt, variants as triangles."""
     plt = _plt()
     fig, ax = plt.subplots(figsize=(7.5, 5.2), dpi=110)
@@ -212,7 +212,7 @@ def write(out: dict[str, Any], path: str, img_dir: str) -> None:
     rel = os.path.relpath(img_dir, os.path.dirname(path))
     meta = out.get("meta", {})
     L: list[str] = []
-    L += ["# Benchmarks: speed against error (issue 4)", "",
+    L += ["# Benchmarks: speed against error, beside Box2D and Chipmunk", "",
           "Regenerate everything on this page (tables, plots, `bench/results/latest.json`) with one command "
           "from the repository root:", "", "```bash",
           "bench/run            # default run, about 1 min on a 2-core VM (3 repeats)",
@@ -259,7 +259,7 @@ def write(out: dict[str, Any], path: str, img_dir: str) -> None:
     summary: list[str] = []
     wp = out.get("wp")
     if wp:
-        L += ["## (1) Seed scene: energy drift against cost (work-precision)", "",
+        L += ["## Seed scene: energy drift against cost (work-precision)", "",
               "20 seed blocks (1 m × 0.5 m, 1 kg) at random cells of a 2 m grid in a walled 10 m box, random "
               "angle, v ∈ [-3, 3] m/s, ω ∈ [-2, 2] rad/s (seeds 1-3), e = 1, no friction, no damping, 10 s. "
               "drift = (E(10 s) − E₀)/E₀, median over seeds; cost = CPU ms per simulated second. Each engine "
@@ -310,8 +310,9 @@ def write(out: dict[str, Any], path: str, img_dir: str) -> None:
 
     ref = out.get("ref")
     if ref:
-        L += ["## (1b) Seed scene: trajectory error against a converged reference", "",
-              f"The same scenes (seeds as in (1)) for the first {ref['horizon']:g} s, states sampled every 1/60 s, "
+        L += ["## Seed scene: trajectory error against a converged reference", "",
+              "The same scenes (seeds as in the energy-drift section) for the first "
+              f"{ref['horizon']:g} s, states sampled every 1/60 s, "
               "compared with a reference: libcollide at its tightest time-of-impact tolerances "
               f"(toi_time_tolerance {ref['settings']['toi_time_tolerance']:g} s, toi_distance_tolerance "
               f"{ref['settings']['toi_distance_tolerance']:g} m) at dt 1/60. error = the farthest any point of "
@@ -321,8 +322,8 @@ def write(out: dict[str, Any], path: str, img_dir: str) -> None:
               "difference, so the horizon is short. The reference is checked by computing it a second way, "
               "at dt 1/960 (other step boundaries, so other round-off and other time-of-impact brackets); "
               "the check line gives how far the two computations are apart, which bounds what this table can "
-              "resolve. Cost = the same setting's CPU ms per simulated second from the 10 s runs of (1)"
-              " (from these short runs where (1) did not run).", ""]
+              "resolve. Cost = the same setting's CPU ms per simulated second from the 10 s runs of the energy-drift "
+              "section (from these short runs where it did not run).", ""]
         for g in ("g0", "g9.8"):
             sec_g = ref.get(g)
             if not sec_g:
@@ -350,7 +351,7 @@ def write(out: dict[str, Any], path: str, img_dir: str) -> None:
 
     imp = out.get("impacts")
     if imp:
-        L += ["## (9) Single impacts, the flat drop and free flight", "",
+        L += ["## Single impacts, the flat drop and free flight: energy and spin against the exact answer", "",
               "Face-on wall hit at 3 m/s (2-point manifold; exact: v' = −3, ω' = 0), corner hit with the block "
               "turned 30°, and a block dropped flat from 2 m onto the floor (g 9.8, exact: E ratio 1, ω 0), "
               "e = 1, μ = 0; states read 1 s after the start (after the single bounce).", "",
@@ -391,7 +392,7 @@ def write(out: dict[str, Any], path: str, img_dir: str) -> None:
 
     cr = out.get("cradle")
     if cr:
-        L += ["## (5) Newton's cradle", "",
+        L += ["## Newton's cradle: final velocities against sequential impacts", "",
               "Striker (1 m × 0.5 m) at 5 m/s into 5 blocks, touching or with 5 cm gaps, e = 1, μ = 0, no "
               "gravity, 3 s, dt 1/60. Exact (sequential impacts): final vx = [0, 0, 0, 0, 0, 5]. "
               "err = max |vx − exact| / v0.", "",
@@ -416,7 +417,7 @@ def write(out: dict[str, Any], path: str, img_dir: str) -> None:
 
     tu = out.get("tunnel")
     if tu:
-        L += ["## (6) Tunnelling", "",
+        L += ["## Tunnelling: a fast block against a thin wall", "",
               "A 0.2 m × 0.2 m block (0.1 kg) at v towards a static wall 0.1 m thick, 1 m away, e = 1, dt 1/60, "
               "0.5 s, state checked after every step. Exact: it comes back at −v.", "",
               "| v (m/s) | " + " | ".join(NAMES[e] + ": tunnelled?, v'/(−v)" for e in ENGINES) + " |",
@@ -436,7 +437,7 @@ def write(out: dict[str, Any], path: str, img_dir: str) -> None:
 
     stx = out.get("stacks")
     if stx:
-        L += ["## (3) Stacks", "",
+        L += ["## Stacks: sink, creep and jitter of the top block", "",
               "N seed blocks (1 m wide, 0.5 m tall) stacked exactly touching on a floor, μ = 0.6, g = 9.8, 10 s, "
               "sleep off. sink = initial − final top-block height (positive = the stack sinks into itself), "
               "dx = sideways drift of the top block, jitter = std of the top height over the last 5 s, "
@@ -468,12 +469,13 @@ def write(out: dict[str, Any], path: str, img_dir: str) -> None:
 
     hd = out.get("hard")
     if hd:
-        L += ["## Hard cases: (2) settling, (7) mass ratio, (8) wedged block, (10) smash", "",
-              "dt 1/60, states sampled every 1/60 s. (2) the 20-block seed scene with e = 0.8, μ = 0.5, g = 9.8, "
-              "10 s (blocks come to rest); (7) a 1000 kg seed block resting on a 1 kg one on the floor, μ = 0.6, "
-              "e = 0, 10 s; (8) a seed block turned 30° with its corners exactly touching two vertical walls, "
+        L += ["## Hard cases: energy and escapes when settling, at a 1:1000 mass ratio, wedged, and in a smash", "",
+              "dt 1/60, states sampled every 1/60 s. settling20: the 20-block seed scene with e = 0.8, μ = 0.5, "
+              "g = 9.8, 10 s (blocks come to rest); mass_ratio_1000: a 1000 kg seed block resting on a 1 kg one "
+              "on the floor, μ = 0.6, e = 0, 10 s; wedged_30deg: a seed block turned 30° with its corners exactly "
+              "touching two vertical walls, "
               "3 m above the floor, μ = 0.6, e = 0, 10 s (friction may hold it or let it slide; it must not pass a "
-              "wall or blow up); (10) a 2 m × 2 m 40 kg block at 20 m/s into a 10 × 10 grid of 0.4 m blocks "
+              "wall or blow up); smash_10x10: a 2 m × 2 m 40 kg block at 20 m/s into a 10 × 10 grid of 0.4 m blocks "
               "(0.16 kg), no gravity, no walls, e = 1, 2 s. ΔE = (E_end − E₀)/E₀; rise = (max E − E₀)/E₀ over the "
               "samples (must stay ≤ 0 up to rounding when nothing drives the scene); p err = linear momentum "
               "error / initial momentum.", "",
@@ -498,7 +500,7 @@ def write(out: dict[str, Any], path: str, img_dir: str) -> None:
 
     py = out.get("pyramid")
     if py:
-        L += ["## (4) Pyramid (Box2D `large_pyramid` layout)", "",
+        L += ["## Pyramid (Box2D `large_pyramid` layout): step cost and top-box drift", "",
               "Unit boxes (1 kg) in rows, μ = 0.6, e = 0, g = 10, dt 1/60, sleep off; "
               "ms per step = median CPU time per 1/60 s step; top moved = displacement of the top box at the end.", "",
               "| base (bodies) | " + " | ".join(NAMES[e] + ": ms/step, top moved (m)" for e in ENGINES) + " |",
@@ -565,7 +567,7 @@ def write(out: dict[str, Any], path: str, img_dir: str) -> None:
             if r and r.get("stages"):
                 rows.append((f"seed 20, {g}", r["stages"], r.get("stage_times") or {}))
     if rows:
-        L += ["## Model only what a scene needs: libcollide's pipeline per scene", "",
+        L += ["## Pipeline stages libcollide ran per scene", "",
               "Which stages ran (counts per step, from `world.counters(last=False)` of the first repeat); an "
               "empty cell means the stage never ran in that scene.", "",
               "| scene | " + " | ".join(name for _, name in STAGES) + " |", "|---|" + "---|" * len(STAGES)]
@@ -638,7 +640,7 @@ def write(out: dict[str, Any], path: str, img_dir: str) -> None:
     if nd:
         L += ["Runs whose repeats did not end in bit-identical states: " + ", ".join(nd) + ".", ""]
 
-    head = ["## Issue 4 targets: where libcollide stands (this run)", "",
+    head = ["## Targets: libcollide's accuracy and cost against its bars (this run)", "",
             "| target | measured | met |", "|---|---|---|"] + summary + [""]
     # insert the summary right after the "How it measures" section
     idx = L.index("## How it measures")
@@ -648,7 +650,7 @@ def write(out: dict[str, Any], path: str, img_dir: str) -> None:
     L += ["## Not covered yet", "",
           "- Pyramid base 100 and scaling beyond 2000 bodies run only in `--full` (up to 5000 bodies); "
           "an engine that did not finish a smaller pyramid is not run on the larger ones.",
-          "- Rapier2D (optional in issue 4; needs a Rust driver) and native Box2D v3 with SIMD: not run here; "
+          "- Rapier2D (needs a Rust driver) and native Box2D v3 with SIMD: not run here; "
           "their figures are in `../shared/notes/peer_bench.md`.",
           "- The 60 s hard-case stability suite belongs to the test suite, not to this benchmark.",
           "- libcollide crashes and hangs found by this benchmark have minimal reproductions in `bench/repro/`.", ""]

@@ -68,7 +68,7 @@ def walls(xmin: float = 0.0, ymin: float = 0.0, xmax: float = BOX, ymax: float =
 
 def seed(n: int = 20, gravity: float = 0.0, seed: int = 1, size: float = BOX, duration: float = 10.0,
          vmax: float = 3.0, wmax: float = 2.0) -> Scene:
-    """(1) n seed blocks at random cells of a 2 m grid in a walled size x size box, random angle,
+    """n seed blocks at random cells of a 2 m grid in a walled size x size box, random angle,
     v in [-vmax, vmax]^2 m/s, omega in [-wmax, wmax] rad/s; e = 1, no friction, no damping."""
     rng = np.random.default_rng(seed)
     cells = int(size // 2.0)
@@ -84,7 +84,7 @@ def seed(n: int = 20, gravity: float = 0.0, seed: int = 1, size: float = BOX, du
 
 
 def cradle(gap: float, v0: float = 5.0, n: int = 5, duration: float = 3.0) -> Scene:
-    """(5) Newton's cradle: a striker (1 m x 0.5 m) at v0 into a row of n blocks whose end faces are
+    """Newton's cradle: a striker (1 m x 0.5 m) at v0 into a row of n blocks whose end faces are
     `gap` apart (0 = touching); no walls, no gravity, e = 1, mu = 0. Exact (sequential) answer: only
     the last block moves, at v0."""
     row = [Box(BLOCK_W, BLOCK_H, 2.0 + i * (BLOCK_W + gap), 0.0) for i in range(n)]
@@ -93,7 +93,7 @@ def cradle(gap: float, v0: float = 5.0, n: int = 5, duration: float = 3.0) -> Sc
 
 
 def flat_drop(height: float = 2.0, duration: float = 1.0, g: float = 9.8) -> Scene:
-    """(9) A block held flat with its bottom face `height` above the floor, released at rest; e = 1.
+    """A block held flat with its bottom face `height` above the floor, released at rest; e = 1.
     Exact: it bounces back to the same height without spin (E ratio 1, omega 0)."""
     floor = Box(20.0, 1.0, 0.0, -0.5, static=True)
     return Scene("flat_drop", (Box(BLOCK_W, BLOCK_H, 0.0, height + BLOCK_H / 2), floor), gravity=g, duration=duration)
@@ -116,14 +116,14 @@ def wall_hit(v: float = 3.0, angle: float = 0.0, duration: float = 1.0) -> Scene
 
 
 def stack(n: int, e: float = 0.0, mu: float = 0.6, duration: float = 10.0, g: float = 9.8) -> Scene:
-    """(3) n seed blocks (1 m wide, 0.5 m tall) stacked exactly touching on a floor; mu 0.6."""
+    """n seed blocks (1 m wide, 0.5 m tall) stacked exactly touching on a floor; mu 0.6."""
     floor = Box(20.0, 1.0, 0.0, -0.5, static=True)
     blocks = [Box(BLOCK_W, BLOCK_H, 0.0, BLOCK_H * (i + 0.5)) for i in range(n)]
     return Scene(f"stack{n}_e{e:g}", tuple(blocks + [floor]), gravity=g, e=e, mu=mu, duration=duration)
 
 
 def pyramid(base: int, duration: float = 500 / 60, g: float = 10.0) -> Scene:
-    """(4) Box2D's large_pyramid layout: unit boxes (1 kg), rows touching, on a ground box; mu 0.6, e 0."""
+    """Box2D's large_pyramid layout: unit boxes (1 kg), rows touching, on a ground box; mu 0.6, e 0."""
     boxes = []
     for i in range(base):
         y = 0.5 + i * 1.0
@@ -135,7 +135,7 @@ def pyramid(base: int, duration: float = 500 / 60, g: float = 10.0) -> Scene:
 
 
 def tunnel(v: float, wall_t: float = 0.1, size: float = 0.2, duration: float = 0.5) -> Scene:
-    """(6) A size x size block at v m/s towards a static wall of thickness wall_t, 1 m away; e = 1.
+    """A size x size block at v m/s towards a static wall of thickness wall_t, 1 m away; e = 1.
     Exact: it comes back at -v; it must never be found beyond the wall."""
     wall = Box(wall_t, 4.0, 1.0 + wall_t / 2, 0.0, static=True)
     b = Box(size, size, 0.0, 0.0, vx=v, mass=0.1)
@@ -151,20 +151,20 @@ def many(n: int, seed_: int = 7) -> Scene:
 
 
 def settling(n: int = 20, e: float = 0.8, mu: float = 0.5, seed_: int = 1, duration: float = 10.0) -> Scene:
-    """(2) The seed scene with e = 0.8, mu = 0.5 and g = 9.8: the blocks come to rest on the floor."""
+    """The seed scene with e = 0.8, mu = 0.5 and g = 9.8: the blocks come to rest on the floor."""
     sc = seed(n, 9.8, seed_, duration=duration)
     return replace(sc, name=f"settling{n}", e=e, mu=mu)
 
 
 def mass_ratio_stack(ratio: float = 1000.0, duration: float = 10.0) -> Scene:
-    """(7) A 1 kg seed block on the floor with a ratio x heavier seed block resting on it; mu 0.6, e 0."""
+    """A 1 kg seed block on the floor with a ratio x heavier seed block resting on it; mu 0.6, e 0."""
     floor = Box(20.0, 1.0, 0.0, -0.5, static=True)
     blocks = [Box(BLOCK_W, BLOCK_H, 0.0, BLOCK_H / 2, mass=1.0), Box(BLOCK_W, BLOCK_H, 0.0, 1.5 * BLOCK_H, mass=ratio)]
     return Scene(f"mass_ratio_{ratio:g}", tuple(blocks + [floor]), gravity=9.8, e=0.0, mu=0.6, duration=duration)
 
 
 def wedged(angle_deg: float = 30.0, mu: float = 0.6, duration: float = 10.0) -> Scene:
-    """(8) A seed block turned by angle_deg whose two lower/upper corners touch two vertical walls exactly
+    """A seed block turned by angle_deg whose two lower/upper corners touch two vertical walls exactly
     (gap = w cos a + h sin a), 3 m above a floor, g = 9.8, mu 0.6, e 0: friction holds it or it slides
     down; it must never pass through a wall or blow up."""
     a = np.radians(angle_deg)
@@ -177,7 +177,7 @@ def wedged(angle_deg: float = 30.0, mu: float = 0.6, duration: float = 10.0) -> 
 
 
 def smash(rows: int = 10, cols: int = 10, v: float = 20.0, e: float = 1.0, duration: float = 2.0) -> Scene:
-    """(10) A heavy 2 m x 2 m block (40 kg) at v m/s into a rows x cols grid of 0.4 m blocks (0.16 kg)
+    """A heavy 2 m x 2 m block (40 kg) at v m/s into a rows x cols grid of 0.4 m blocks (0.16 kg)
     spaced 0.5 m, no gravity, no walls, e = 1: momentum and energy must be conserved."""
     heavy = Box(2.0, 2.0, -3.0, 0.5 * (rows - 1) * 0.5, vx=v, mass=40.0)
     grid = [Box(0.4, 0.4, 0.5 * c, 0.5 * r, mass=0.16) for r in range(rows) for c in range(cols)]

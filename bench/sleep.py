@@ -6,7 +6,7 @@ the same pyramid awake, and a box dropped on the sleeping pyramid.
 1. Awake: bench/scenes.py's pyramid(base) (base 50: 1 275 unit boxes, mu 0.6, e 0, g 10) with sleep off;
    after 60 steps from the cold start, the CPU per step of the next 120 (thread time).
 2. Asleep: the same with allow_sleep = 1: stepped until every box sleeps (at most 600 steps), then the
-   CPU per step of the next 120. The ratio asleep / awake is the cost of rest (issue 23: <= 5 %).
+   CPU per step of the next 120. The ratio asleep / awake is the cost of rest (to be <= 5 %).
 3. Dropped on it: with allow_sleep = 1, a 5 kg unit box 10 m above the top falls onto the pyramid
    asleep by then; reported: the step it wakes the pyramid, the deepest overlap of any two boxes at
    any step end from there (bench/metrics.py, exact separating-axis depth), whether every body sleeps

@@ -7,7 +7,9 @@ Markers (all in ``world_frame``):
 - ns ``springs``: one LINE_LIST per spring (id = index), from the body point to the target.
 - ns ``contacts``: id 0 POINTS at the contact points, id 1 LINE_LIST along the normals (0.3 m),
   replaced every publish and DELETEd when there are none.
-A reset first publishes a DELETEALL marker (action 3).
+A reset (and the start, and a kill) publishes one message that begins with a DELETEALL marker (action 3)
+and goes on with the new scene: with the publisher's depth-1 history, a DELETEALL sent on its own could
+be replaced by the next message before a subscriber took it.
 
 Field order is visualization_msgs/msg/Marker of ROS 2 Jazzy (texture, uv_coordinates, mesh_file
 included); tests/python/test_node_cdr.py compares these bytes with rclpy's serializer.
@@ -98,13 +100,16 @@ class MarkerArrayCdr:
     """Body outlines as a template; springs and contacts appended per publish."""
 
     def __init__(self, frame_id: str, ids: Sequence[int], outlines: Sequence[np.ndarray],
-                 colors: Sequence[Color], line_width: float = 0.05) -> None:
+                 colors: Sequence[Color], line_width: float = 0.05, lead: Sequence[MarkerSpec] = ()) -> None:
+        """lead: markers before the bodies (a DELETEALL), stamped as they are."""
         self.frame_id = frame_id
-        self.n = len(ids)
+        self.n = len(lead) + len(ids)
         w = CdrWriter()
         w.u32(0)  # marker count, rewritten per publish
         stamps: list[int] = []
         poses: list[int] = []
+        for spec in lead:
+            stamps.append(write_marker(w, spec, 0, 0, frame_id)[0])
         for bid, outline, color in zip(ids, outlines, colors):
             loop = np.vstack([outline, outline[:1]])
             pts = np.zeros((len(loop), 3))
@@ -123,7 +128,8 @@ class MarkerArrayCdr:
         t._u32[0] = np.uint32(self.n + len(extras))
         if self.n:
             t.set_stamp(sec, nanosec)
-            t.set_doubles("pose", poses)
+            if len(poses):
+                t.set_doubles("pose", poses)
         head = t.tobytes()
         if not extras:
             return head
@@ -133,10 +139,14 @@ class MarkerArrayCdr:
         return head + bytes(w.buf[len(ENCAPSULATION) + self._end:])
 
 
+DELETE_ALL = MarkerSpec("", 0, 0, DELETEALL)
+
+
 def delete_all(frame_id: str, sec: int, nanosec: int) -> bytes:
+    """A MarkerArray of the DELETEALL marker alone."""
     w = CdrWriter()
     w.u32(1)
-    write_marker(w, MarkerSpec("", 0, 0, DELETEALL), sec, nanosec, frame_id)
+    write_marker(w, DELETE_ALL, sec, nanosec, frame_id)
     return bytes(w.buf)
 
 

@@ -393,7 +393,8 @@ class SimNode(Node):
         for i, n in enumerate(self._names):
             outlines.append(self._bodies[n].local_vertices())
             colors.append(_hex_color(self._colors.get(n), markers.body_color(n, i, bool(static[i]))))
-        self._cdr_markers = markers.MarkerArrayCdr(frame, [int(i) for i in self._ids], outlines, colors)
+        ids = [int(i) for i in self._ids]
+        self._cdr_markers = markers.MarkerArrayCdr(frame, ids, outlines, colors)
         # per-body thrust subscriptions for the first max_body_topics dynamic bodies
         want = set(self._dyn_names[: int(self._p["max_body_topics"])])
         for name in list(self._thrust_subs):
@@ -416,10 +417,10 @@ class SimNode(Node):
         self._ext_bodies &= set(self._names)
         for sname in [s for s, e in self._springs.items() if e.body not in self._row_of]:
             del self._springs[sname]
-        if deleteall:
-            sec, ns = cdr.split_time(self.sim_time)
-            self._pub_markers.publish(markers.delete_all(frame, sec, ns))
-        self._publish_markers()
+        # DELETEALL heads the new scene's message: sent on its own, the depth-1 history could replace it
+        # with the scene before a subscriber (RViz, the live view) took it
+        self._publish_markers(markers.MarkerArrayCdr(frame, ids, outlines, colors, lead=[markers.DELETE_ALL])
+                              if deleteall else None)
 
     def _periods(self) -> None:
         dt = float(self._p["time_step"])
@@ -1056,14 +1057,15 @@ class SimNode(Node):
         st = self.world.state[self._dyn_rows]
         self._pub_tf.publish(self._cdr_tf.encode(sec, ns, cdr.poses_from_state(st)))
 
-    def _publish_markers(self) -> None:
+    def _publish_markers(self, template: markers.MarkerArrayCdr | None = None) -> None:
+        """The bodies, springs and contacts; ``template``: another body template (one with DELETEALL)."""
         sec, ns = self._stamp()
         poses = cdr.poses_from_state(self.world.state)
         ends = [(np.asarray(a), np.asarray(b)) for a, b in (e.spring.endpoints() for e in self._springs.values())]
         extras = markers.spring_markers(ends)
         c = self.world.contacts
         extras += markers.contact_markers(np.array(c["point"]).reshape(-1, 2), np.array(c["normal"]).reshape(-1, 2))
-        self._pub_markers.publish(self._cdr_markers.encode(sec, ns, poses, extras))
+        self._pub_markers.publish((template or self._cdr_markers).encode(sec, ns, poses, extras))
 
     def _publish_diagnostics(self) -> None:
         wall, cpu, sim = time.perf_counter(), time.process_time(), self.sim_time

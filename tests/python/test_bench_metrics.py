@@ -1,7 +1,7 @@
 """The benchmark's trajectory error (bench/metrics.py) against displacements computed here by hand.
 
 The error must bound how far any point of a block moved from the reference: it is what the
-benchmark's section (1b) ranks engines by, so a measure that under-reports would flatter whichever
+benchmark's trajectory-error section ranks engines by, so a measure that under-reports would flatter whichever
 engine drifts by rotation."""
 from __future__ import annotations
 

@@ -9,7 +9,7 @@ block ends at v = F/m * timeout, up to one step (dt = 1 ms) of quantisation.
 from __future__ import annotations
 
 import math
-from typing import Iterator
+from typing import Any, Iterator
 
 import pytest
 from geometry_msgs.msg import Point, Twist, TwistStamped, Vector3, WrenchStamped
@@ -241,9 +241,15 @@ def test_reset_restores_scene_and_clock_runs_on(sim: SimClient) -> None:
     assert sim.call(Empty, "reset") is not None
     assert sim.wait_for(lambda: at_start(sim), 20.0)
     s = sim.body_state("block1")
-    # markers: a DELETEALL went out for the reset, then the new scene
-    assert sim.wait_for(lambda: any(m.action == 3 for _, arr in list(sim.history["markers"])[n_markers:]
-                                    for m in arr.markers), 10.0)
+    # markers: one message, DELETEALL first, then the new scene (so no subscriber gets one without the other)
+    def reset_markers() -> Any:
+        return next((arr for _, arr in list(sim.history["markers"])[n_markers:]
+                     if any(m.action == 3 for m in arr.markers)), None)
+    assert sim.wait_for(reset_markers, 10.0)
+    arr = reset_markers().markers
+    assert arr[0].action == 3 and all(m.action != 3 for m in arr[1:])
+    assert sorted(m.id for m in arr if m.ns == "bodies") == sorted(m.id for m in sim.last["markers"].markers
+                                                                   if m.ns == "bodies")
     assert s[0] == pytest.approx(-2.5, abs=1e-9) and s[3] == 0.0
     assert (sim.sim_time() or 0.0) >= t_before  # time keeps running forward across a reset
 

@@ -116,18 +116,21 @@ def marker_obj(spec: markers.MarkerSpec, sec: int, ns: int, frame: str) -> Marke
     return m
 
 
-@pytest.mark.parametrize("n_contacts", [0, 3])
-def test_marker_array(n_contacts: int) -> None:
+@pytest.mark.parametrize("n_contacts,lead", [(0, False), (3, False), (3, True)])
+def test_marker_array(n_contacts: int, lead: bool) -> None:
+    """The bodies' template, springs and contacts; with lead (a reset), DELETEALL first in the same message."""
     outlines = [np.array([[-0.5, -1.5], [0.5, -1.5], [0.5, 1.5], [-0.5, 1.5]]),
                 np.array([[0.0, 0.0], [1.0, 0.0], [0.3, 0.7]]) - 0.1]
     colors = [markers.GREEN, markers.PALETTE[1]]
-    w = markers.MarkerArrayCdr("world", [3, 17], outlines, colors)
+    w = markers.MarkerArrayCdr("world", [3, 17], outlines, colors, lead=[markers.DELETE_ALL] if lead else [])
     st = random_state(2)
     extras = markers.spring_markers([(np.array([0.1, 0.2]), np.array([1.0, 2.0]))])
     pts, nrm = RNG.normal(size=(n_contacts, 2)), RNG.normal(size=(n_contacts, 2))
     extras += markers.contact_markers(pts, nrm)
     raw = w.encode(5, 6, cdr.poses_from_state(st), extras)
     msg = MarkerArray()
+    if lead:
+        msg.markers.append(marker_obj(markers.DELETE_ALL, 5, 6, "world"))
     for bid, outline, color, row in zip([3, 17], outlines, colors, st):
         loop = np.vstack([outline, outline[:1]])
         spec = markers.MarkerSpec("bodies", bid, markers.LINE_STRIP, markers.ADD,
@@ -138,7 +141,9 @@ def test_marker_array(n_contacts: int) -> None:
         msg.markers.append(marker_obj(spec, 5, 6, "world"))
     # float32 colours: compare after the same rounding the serializer applies
     check(raw, deserialize_message(serialize_message(msg), MarkerArray))
-    assert len(deserialize_message(raw, MarkerArray).markers) == 2 + 1 + 2
+    got = deserialize_message(raw, MarkerArray).markers
+    assert len(got) == lead + 2 + 1 + 2
+    assert (got[0].action == Marker.DELETEALL) == lead
 
 
 def test_delete_all() -> None:

@@ -1,4 +1,4 @@
-"""Short soak (issue 5, item 4): soak/soak.py for 75 s of wall time at real_time_factor 0.
+"""Short soak: soak/soak.py for 150 s of wall time at real_time_factor 0.
 
 What run_soak checks, and why each bound holds, is in soak/soak.py; this test asserts each check
 separately so a failure names what broke. The one-hour run is the same code with --duration 3600

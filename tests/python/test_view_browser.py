@@ -10,10 +10,6 @@ import io
 import json
 import math
 import os
-import re
-import subprocess
-import sys
-import tempfile
 import time
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
@@ -25,7 +21,8 @@ import rclpy
 from libcollide_msgs.msg import SpringCommand, ThrusterCommand
 from std_srvs.srv import Empty
 
-from collide_ros.testing import NodeProcess, SimClient, _die_with_parent
+from collide_ros.testing import NodeProcess, SimClient
+from view_process import ViewProcess
 
 CHROMIUM = "/usr/bin/chromium"
 GIVE_UP = 60.0  # s: guards against a hung test only; never a pass/fail criterion
@@ -41,42 +38,6 @@ def _need_browser() -> Any:
         pytest.fail(f"playwright is not installed ({exc}); run scripts/setup (requirements.txt pins it)",
                     pytrace=False)
     return sync_playwright
-
-
-class ViewProcess:
-    """``python -m collide_ros.view --port P`` in a child process; the URL it prints."""
-
-    def __init__(self, port: int = 0) -> None:
-        self.log = tempfile.NamedTemporaryFile(prefix="view_", suffix=".log", delete=False)
-        env = dict(os.environ, PYTHONUNBUFFERED="1", RCUTILS_COLORIZED_OUTPUT="0")
-        self.proc = subprocess.Popen([sys.executable, "-m", "collide_ros.view", "--port", str(port)],
-                                     stdout=self.log, stderr=subprocess.STDOUT, env=env,
-                                     preexec_fn=_die_with_parent)
-        end = time.monotonic() + GIVE_UP
-        self.url = ""
-        while not self.url:
-            m = re.search(r"view: open (http://\S+)", self.output())
-            if m:
-                self.url = m.group(1)
-                break
-            assert self.proc.poll() is None, f"the view exited:\n{self.output()}"
-            assert time.monotonic() < end, f"the view printed no URL:\n{self.output()}"
-            time.sleep(0.05)
-        self.port = int(self.url.rstrip("/").rsplit(":", 1)[1])
-
-    def output(self) -> str:
-        self.log.flush()
-        return Path(self.log.name).read_text(errors="replace")
-
-    def stop(self) -> int:
-        if self.proc.poll() is None:
-            self.proc.send_signal(2)
-            try:
-                self.proc.wait(15)
-            except subprocess.TimeoutExpired:
-                self.proc.kill()
-                self.proc.wait(15)
-        return int(self.proc.returncode)
 
 
 @dataclass
@@ -305,6 +266,19 @@ def test_pause_step_run_reset_buttons(stack: Stack) -> None:
     resets = stack.js("window.__view.resets")
     click("#reset", "reset")
     stack.until(lambda: stack.js("window.__view.resets") > resets, "the page to count the reset")
+
+
+def test_resets_from_another_node_each_reach_the_page(stack: Stack) -> None:
+    # each reset's markers message (DELETEALL first, then the new scene) reaches the view: the page
+    # counts every reset asked for over ROS once, none lost, none twice
+    stack.reset()
+    r0 = stack.js("window.__view.resets")
+    for _ in range(3):
+        assert stack.client.call(Empty, "reset") is not None, "sim/reset did not answer"
+        stack.client.spin(0.3)
+    stack.until(lambda: stack.js("window.__view.resets") >= r0 + 3, "the page to count three resets")
+    stack.client.spin(0.5)
+    assert stack.js("window.__view.resets") == r0 + 3
 
 
 def test_spawned_body_appears_and_killed_body_goes(stack: Stack) -> None:

@@ -24,6 +24,7 @@ from visualization_msgs.msg import MarkerArray
 from collide_ros import qos
 from collide_ros.cdr import join_time
 from collide_ros.diag_name import physics_status, sim_node_name
+from collide_ros.params import frame_prefix_for
 from collide_ros.teleop import N_THRUSTERS, firing_for
 from collide_ros.view.protocol import PARAMS
 from collide_ros.view.scene import SceneState, yaw_of
@@ -34,11 +35,14 @@ ANSWER_WAIT = 15.0      # s: ... and for the node's answer
 WATCH_PERIOD = 0.5      # s: is the sim node there? parameters refreshed every other tick
 LATEST = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=5, reliability=ReliabilityPolicy.BEST_EFFORT,
                     durability=DurabilityPolicy.VOLATILE)
-# depth 10: a reset publishes DELETEALL and the new markers back to back; depth 1 would lose the first
+# reliable, transient local: a late view gets the node's latest markers; depth 10 keeps a reset's message
+# (DELETEALL + the new scene) while the executor is busy
 LATCHED = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=10, reliability=ReliabilityPolicy.RELIABLE,
                      durability=DurabilityPolicy.TRANSIENT_LOCAL)
 
 Reply = Callable[[bool, str], None]
+#: the node's frame names (strings), read with the parameters: /tf and the Foxglove stream name frames so
+FRAME_PARAMS = ("world_frame", "frame_prefix")
 
 
 def _param_value(name: str, value: float | int) -> ParameterValue:
@@ -61,6 +65,9 @@ class ViewBridge(Node):
         self.node_alive = False
         self.params: dict[str, Any] = {}
         self.health: dict[str, Any] | None = None
+        # the node's defaults; frames_known once its parameters are read
+        self.frames = {"world_frame": "world", "frame_prefix": frame_prefix_for(self.get_namespace())}
+        self.frames_known = False
         self._held: dict[int, frozenset[str]] = {}   # client -> thruster keys held
         self._active: set[int] = set()               # block slots firing now
         self._springs: dict[int, str] = {}            # client -> spring name in use
@@ -133,6 +140,7 @@ class ViewBridge(Node):
                 self.scene.gone()
                 self.health = None
                 self.params = {}
+                self.frames_known = False
             self.node_alive = alive
         self._ticks += 1
         if alive and not self._polling and (self._ticks % 2 == 0 or not self.params):
@@ -144,7 +152,7 @@ class ViewBridge(Node):
         if not cli.service_is_ready():
             return
         self._polling = True
-        names = list(PARAMS)
+        names = [*PARAMS, *FRAME_PARAMS]
         fut = cli.call_async(GetParameters.Request(names=names))
 
         def done(f: Any) -> None:
@@ -153,13 +161,18 @@ class ViewBridge(Node):
             if resp is None:
                 return
             vals: dict[str, Any] = {}
+            frames: dict[str, str] = {}
             for n, v in zip(names, resp.values):
                 if v.type == ParameterType.PARAMETER_DOUBLE:
                     vals[n] = v.double_value
                 elif v.type == ParameterType.PARAMETER_INTEGER:
                     vals[n] = v.integer_value
+                elif v.type == ParameterType.PARAMETER_STRING and n in FRAME_PARAMS:
+                    frames[n] = v.string_value
             with self.lock:
                 self.params = vals
+                self.frames.update(frames)
+                self.frames_known = self.frames_known or len(frames) == len(FRAME_PARAMS)
         fut.add_done_callback(done)
 
     # ---------------------------------------------------------------- commands (thread-safe)
@@ -261,11 +274,7 @@ class ViewBridge(Node):
                 self.refresh_params()
             reply(bool(r.successful), r.reason or f"{args['name']} = {args['value']:g}")
         elif kind == "reset":
-            # the node's DELETEALL marker may be overwritten in its depth-1 history before it
-            # reaches us: a reset asked for here starts the energy's start mark over at once
-            with self.lock:
-                self.scene.restarted()
-                self.scene.resets += 1
+            # the view starts over when the node's markers message of the reset (DELETEALL first) arrives
             reply(True, "reset")
         else:
             reply(bool(resp.success), resp.message)
@@ -283,6 +292,11 @@ class ViewBridge(Node):
     def shapes(self) -> dict[str, Any]:
         with self.lock:
             return self.scene.shapes_message()
+
+    def frame_names(self) -> tuple[str, str] | None:
+        """(world_frame, frame_prefix) of the sim node; None until its parameters have been read."""
+        with self.lock:
+            return (self.frames["world_frame"], self.frames["frame_prefix"]) if self.frames_known else None
 
 
 def spin_in_thread(node: Node) -> tuple[threading.Thread, SingleThreadedExecutor]:

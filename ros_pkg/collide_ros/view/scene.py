@@ -78,7 +78,7 @@ class SceneState:
     _rtf_ref: tuple[float, float] | None = None
     rtf: float | None = None
     seq: int = 0  # bumps on every change worth sending
-    resets: int = 0  # DELETEALL markers seen and resets asked for by the view
+    resets: int = 0  # DELETEALL markers seen (a reset, a kill, a new node)
 
     # ---------------------------------------------------------------- input
     def on_states(self, stamp: float, names: list[str], poses: list[Pose],

@@ -1,10 +1,12 @@
 """The view's web server: one self-contained page on ``/`` and the sim streamed on ``/ws``.
 
-    python -m collide_ros.view [--host 127.0.0.1] [--port 8080] [--rate 30] [--ros-args -r __ns:=/robot1]
+    python -m collide_ros.view [--host 127.0.0.1] [--port 8080] [--rate 30] [--foxglove [--foxglove-port 8765]]
+                               [--ros-args -r __ns:=/robot1]
 
 HTTP and the WebSocket share one port (websockets' ``process_request`` serves the page). Each page
 gets the latest state at ``--rate`` Hz: a frame is built from the newest data when it is due and
-sent before the next one is built, so a slow page gets fewer frames, never a backlog.
+sent before the next one is built, so a slow page gets fewer frames, never a backlog. ``--foxglove``
+also serves the scene over the Foxglove WebSocket protocol (foxglove_bridge.py) on the same host.
 """
 from __future__ import annotations
 
@@ -170,8 +172,29 @@ async def serve_forever(server: ViewServer, host: str, port: int) -> None:
         await stop.wait()
 
 
-def main(argv: list[str] | None = None) -> int:
-    args = list(sys.argv[1:] if argv is None else argv)
+def _start_foxglove(bridge: ViewBridge, host: str, port: int, rate: float) -> Any:
+    """The Foxglove WebSocket server (foxglove-sdk, imported only for --foxglove); None if it cannot
+    start (the reason printed)."""
+    try:
+        from collide_ros.view.foxglove_bridge import FoxgloveStream
+    except ImportError as exc:
+        print(f"view: --foxglove needs foxglove-sdk ({exc}); run scripts/setup (requirements.txt pins it)",
+              file=sys.stderr)
+        return None
+    try:
+        fox = FoxgloveStream(bridge, host, port, rate).start()
+    except Exception as exc:  # the SDK raises its own error types (e.g. the port is taken)
+        print(f"view: cannot serve Foxglove WebSocket on {host}:{port}: {exc}", file=sys.stderr)
+        return None
+    shown = "127.0.0.1" if host in ("", "0.0.0.0") else host
+    print(f"view: Foxglove WebSocket on ws://{shown}:{fox.port} (topics {', '.join(fox.topics.values())})",
+          flush=True)
+    return fox
+
+
+def parse_args(argv: list[str]) -> tuple[argparse.Namespace, list[str]]:
+    """(the view's options, the ROS arguments from --ros-args on); exits with a usage error on bad ones."""
+    args = list(argv)
     ros_args = ["--ros-args", *args[args.index("--ros-args") + 1:]] if "--ros-args" in args else []
     if "--ros-args" in args:
         args = args[:args.index("--ros-args")]
@@ -185,13 +208,28 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--bodies", nargs=2, default=["block1", "block2"], metavar=("B1", "B2"),
                    help="bodies driven by S,D,F,E and J,K,L,I / arrows")
     p.add_argument("--stiffness", type=float, default=0.0, help="spring stiffness (N/m); 0: the node's default")
+    p.add_argument("--foxglove", action="store_true",
+                   help="also serve the scene over the Foxglove WebSocket protocol (Foxglove, Lichtblick)")
+    p.add_argument("--foxglove-port", type=int, default=8765,
+                   help="port of the Foxglove WebSocket server, on --host (default 8765; 0: any free port)")
     a = p.parse_args(args)
-    if not 1.0 <= a.rate <= 120.0 or not 0 <= a.port <= 65535 or not a.stiffness >= 0:
-        p.error("--rate must be in 1..120, --port in 0..65535, --stiffness >= 0")
+    if (not 1.0 <= a.rate <= 120.0 or not 0 <= a.port <= 65535 or not 0 <= a.foxglove_port <= 65535
+            or not a.stiffness >= 0):
+        p.error("--rate must be in 1..120, --port and --foxglove-port in 0..65535, --stiffness >= 0")
+    return a, ros_args
+
+
+def main(argv: list[str] | None = None) -> int:
+    a, ros_args = parse_args(sys.argv[1:] if argv is None else argv)
     rclpy.init(args=[sys.argv[0], *ros_args])
     bridge = ViewBridge(sim=a.sim, bodies=(a.bodies[0], a.bodies[1]), stiffness=a.stiffness)
     thread, ex = spin_in_thread(bridge)
+    fox = None
     try:
+        if a.foxglove:
+            fox = _start_foxglove(bridge, a.host, a.foxglove_port, a.rate)
+            if fox is None:
+                return 2
         asyncio.run(serve_forever(ViewServer(bridge, a.rate), a.host, a.port))
     except OSError as exc:
         print(f"view: cannot serve on {a.host}:{a.port}: {exc}", file=sys.stderr)
@@ -199,6 +237,8 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         pass
     finally:
+        if fox is not None:
+            fox.stop()
         for client in list(bridge._springs):
             bridge.release(client)
         rclpy.try_shutdown()
