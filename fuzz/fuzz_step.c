@@ -12,6 +12,10 @@
  *    FZ_MAX_SERIAL_ITERS serial impulse iterations and FZ_MAX_SOLVER_WORK_PER_BODY solver work per body
  *    (work, not wall time: the verdict is the same on any machine, under any load, with or without
  *    sanitizers);
+ *  - the input's final world survives a snapshot (lc_world_save / lc_world_load): a world loaded from it
+ *    has the same state hash and saves the same bytes, and copies with a byte flipped (the checksum made
+ *    right again, so the loader's own checks are what stands) or cut short are refused with a message and
+ *    leave the world unchanged, or load (this reads no input, so older inputs decode as before);
  *  - after every step (successful or not): time and every state number are finite, and no two
  *    bodies (except static-static pairs, which the engine never separates) overlap by more than
  *    FZ_OVERLAP_TOL + round-off, measured here with our own separating-axis test on the world
@@ -731,6 +735,83 @@ static void fz_command(fz_in *in, fz_ctx *c)
     }
 }
 
+/* ---- snapshots ------------------------------------------------------------------------------------- */
+
+static uint64_t fz_fnv1a(const uint8_t *p, size_t n)
+{
+    uint64_t h = 1469598103934665603ULL;
+    size_t i;
+    for (i = 0; i < n; ++i) {
+        h ^= p[i];
+        h *= 1099511628211ULL;
+    }
+    return h;
+}
+
+/* The snapshot's checksum (header bytes 24..31, little-endian, docs/events_and_snapshots.md) made right
+ * for its payload (from byte 32). */
+static void fz_fix_checksum(uint8_t *p, size_t n)
+{
+    uint64_t h = fz_fnv1a(p + 32, n - 32);
+    int k;
+    for (k = 0; k < 8; ++k) p[24 + k] = (uint8_t)(h >> (8 * k));
+}
+
+/* A load of the n bytes at p into c->w: refused with a message and the world's snapshot (was) unchanged,
+ * or accepted, after which the world goes back to was. */
+static void fz_load_or_refuse(fz_ctx *c, const uint8_t *p, size_t n, const uint8_t *was, size_t was_n)
+{
+    uint64_t h = lc_world_state_hash(c->w);
+    lc_status s = lc_world_load(c->w, p, n);
+    if (s == LC_OK) {
+        if (lc_world_load(c->w, was, was_n) != LC_OK) fz_fail("the world's own snapshot does not load", lc_world_last_error(c->w));
+        return;
+    }
+    if (lc_world_last_error(c->w)[0] == '\0') fz_fail("a refused snapshot left no message", NULL);
+    if (lc_world_state_hash(c->w) != h) fz_fail("a refused snapshot changed the world", lc_world_last_error(c->w));
+    {
+        size_t m = 0;
+        uint8_t *now = malloc(was_n);
+        if (now == NULL) return;
+        if (lc_world_save(c->w, now, was_n, &m) != LC_OK || m != was_n || memcmp(now, was, was_n) != 0)
+            fz_fail("a refused snapshot changed the world's snapshot", NULL);
+        free(now);
+    }
+}
+
+static void fz_snapshot(fz_ctx *c)
+{
+    size_t n = 0, m = 0, i;
+    uint8_t *b, *again, *bad;
+    lc_world *x;
+    char err[256];
+    uint64_t h;
+    if (lc_world_save(c->w, NULL, 0, &n) != LC_OK) fz_fail("the snapshot's size query failed", lc_world_last_error(c->w));
+    b = malloc(n);
+    again = malloc(n);
+    bad = malloc(n);
+    if (b == NULL || again == NULL || bad == NULL) fz_fail("out of memory in the harness", NULL);
+    if (lc_world_save(c->w, b, n, &m) != LC_OK || m != n) fz_fail("lc_world_save failed", lc_world_last_error(c->w));
+    x = lc_world_create_from_snapshot(b, n, err, sizeof err);
+    if (x == NULL) fz_fail("the world's snapshot does not load", err);
+    if (lc_world_state_hash(x) != lc_world_state_hash(c->w)) fz_fail("a loaded snapshot has another state", NULL);
+    if (lc_world_save(x, again, n, &m) != LC_OK || m != n || memcmp(again, b, n) != 0)
+        fz_fail("a loaded snapshot saves other bytes", NULL);
+    lc_world_destroy(x);
+    h = fz_fnv1a(b, n);
+    for (i = 0; i < 12; ++i) {
+        size_t at = 32 + (size_t)((h + i * 7919u) % (n - 32));
+        memcpy(bad, b, n);
+        bad[at] ^= (uint8_t)(1u << ((h >> i) & 7u));
+        fz_fix_checksum(bad, n);
+        fz_load_or_refuse(c, bad, n, b, n);
+    }
+    fz_load_or_refuse(c, b, n - 1 - (size_t)(h % (n - 1)), b, n);
+    free(b);
+    free(again);
+    free(bad);
+}
+
 /* ---- entry point ----------------------------------------------------------------------------------- */
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
@@ -763,6 +844,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     }
     for (k = 0; k < MAX_COMMANDS && !fz_done(&in) && fz_may_step(&c); ++k) fz_command(&in, &c);
     if (c.steps == 0) fz_step(&in, &c); /* every input steps at least once */
+    fz_snapshot(&c);
     lc_world_destroy(c.w);
 #ifdef FZ_REPLAY_MAIN
     {

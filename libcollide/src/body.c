@@ -73,6 +73,8 @@ static int reserve_id(lc_world *w, lc_body_id id)
     return 1;
 }
 
+int lc_world_reserve(lc_world *w, int bodies, lc_body_id id) { return reserve_bodies(w, bodies) && reserve_id(w, id); }
+
 lc_status lc_world_add_body(lc_world *w, const lc_body_def *d, lc_body_id *out_id)
 {
     lc_shape shape;

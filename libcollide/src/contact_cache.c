@@ -2,6 +2,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "contact_cache.h"
+#include "snapshot_io.h"
 
 typedef struct entry {
     lc_contact_key key;
@@ -111,4 +112,36 @@ void lc_contact_cache_clear(lc_contact_cache *c)
 {
     c->nread = c->nwrite = 0;
     c->size = 0;
+}
+
+void lc_contact_cache_save(const lc_contact_cache *c, lc_writer *out)
+{
+    int i;
+    lc_put_i32(out, c->nwrite);
+    for (i = 0; i < c->nwrite; ++i) {
+        const entry *e = &c->write[i];
+        lc_put_u32(out, e->key.a);
+        lc_put_u32(out, e->key.b);
+        lc_put_i32(out, e->key.vertex);
+        lc_put_i32(out, e->key.edge);
+        lc_put_f64(out, e->force_n);
+        lc_put_f64(out, e->force_t);
+    }
+}
+
+int lc_contact_cache_load(lc_contact_cache *c, lc_reader *in)
+{
+    int n = lc_get_count(in, 0, 1 << 30, 32, "the contact cache's entries"), i;
+    for (i = 0; i < n && !in->bad; ++i) {
+        lc_contact_key key;
+        double fn, ft;
+        key.a = lc_get_u32(in);
+        key.b = lc_get_u32(in);
+        key.vertex = lc_get_i32(in);
+        key.edge = lc_get_i32(in);
+        fn = lc_get_finite(in, "a kept contact force");
+        ft = lc_get_finite(in, "a kept friction force");
+        if (!in->bad && lc_contact_cache_store(c, key, fn, ft) != 0) return -1;
+    }
+    return 0;
 }

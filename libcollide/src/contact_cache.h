@@ -29,4 +29,11 @@ void lc_contact_cache_drop_stored(lc_contact_cache *c);
 /* Forgets everything (bodies removed: their ids are never reused, but a cleared world starts cold). */
 void lc_contact_cache_clear(lc_contact_cache *c);
 
+struct lc_writer;
+struct lc_reader;
+/* Snapshots (snapshot.c): what the next step reads, the entries stored since lc_contact_cache_next_step,
+ * written, and read back into an empty cache. Load: 0, or -1 without memory (bad input: in->bad). */
+void lc_contact_cache_save(const lc_contact_cache *c, struct lc_writer *out);
+int lc_contact_cache_load(lc_contact_cache *c, struct lc_reader *in);
+
 #endif

@@ -25,6 +25,7 @@
 #include "contact_cache.h"
 #include "contact_exact.h"
 #include "contact_solver.h"
+#include "events.h"
 #include "kept_touches.h"
 #include "tunables.h"
 #include "world.h"
@@ -105,6 +106,18 @@ void lc_contact_regime_forget(lc_contact_regime *cr)
 {
     lc_contact_cache_clear(cr->cache);
     lc_kept_touches_clear(cr->kept);
+}
+
+void lc_contact_regime_save(const lc_contact_regime *cr, const lc_world *w, struct lc_writer *out)
+{
+    lc_contact_cache_save(cr->cache, out);
+    lc_kept_touches_save(cr->kept, w, out);
+}
+
+int lc_contact_regime_load(lc_contact_regime *cr, const lc_world *w, struct lc_reader *in)
+{
+    if (lc_contact_cache_load(cr->cache, in) != 0) return -1;
+    return lc_kept_touches_load(cr->kept, w, in);
 }
 
 /* The island's bodies as the solver sees them: velocities at the start of the sub-step (v0), the
@@ -362,7 +375,7 @@ static int impacts(island_ctx *c, lc_touch *t, int nt, double h)
         if (x->vn_pre < -vr) {
             real = 1;
             w->last.impulses++;
-            if (lc_push_contact(w, x, LC_CONTACT_COLLISION) != 0) return -1;
+            if (lc_record_impact(w, x, LC_IMPACT_CONTACT) != 0) return -1;
         }
     }
     memcpy(c->b.v0, c->b.v, (size_t)c->b.n * 3 * sizeof(double));
@@ -747,7 +760,7 @@ int lc_contact_advance(lc_world *w, lc_contact_regime *cr, const lc_island *isl,
 {
     island_ctx c;
     double e0 = 0.0, ke0 = 0.0, size0 = 0.0, h = dt;
-    int i, k, nt = 0, nend = 0, driven, status, ncontacts = w->contact_count;
+    int i, k, nt = 0, nend = 0, driven, status, ncontacts = w->contact_count, nevents = lc_events_staged(w->events);
     double *start;
     memset(&c, 0, sizeof c);
     c.w = w;
@@ -772,6 +785,7 @@ int lc_contact_advance(lc_world *w, lc_contact_regime *cr, const lc_island *isl,
         w->last.contact_precise_retries++;
         for (i = 0; i < isl->nrows; ++i) memcpy(&w->state[isl->rows[i] * 6], &start[i * 6], 6 * sizeof(double));
         w->contact_count = ncontacts;
+        lc_events_unstage(w->events, nevents);
         c.precise = 1;
         status = advance(&c, dt, driven, e0, size0, &nend, &nt, &h);
     }

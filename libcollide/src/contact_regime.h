@@ -19,6 +19,13 @@ int lc_contact_regime_begin_step(lc_contact_regime *cr);
 void lc_contact_regime_retry(lc_contact_regime *cr);
 /* Forgets every kept contact force (the bodies changed wholesale). */
 void lc_contact_regime_forget(lc_contact_regime *cr);
+/* Snapshots (snapshot.c): what the next step reads, its warm start (contact_cache.c) and kept touches
+ * (kept_touches.c), written, and read back into a new world's (w: its bodies already loaded). Load: 0,
+ * or -1 without memory (bad input: in->bad). */
+struct lc_writer;
+struct lc_reader;
+void lc_contact_regime_save(const lc_contact_regime *cr, const struct lc_world *w, struct lc_writer *out);
+int lc_contact_regime_load(lc_contact_regime *cr, const struct lc_world *w, struct lc_reader *in);
 
 /* Advances the island's bodies (w->state rows) by dt. Its impacts and the resting contacts at its
  * end go to the world's contacts, its work to w->last. Returns 0, -1 without memory, -2 when the

@@ -12,6 +12,7 @@
 #include "event_crossings.h"
 #include "event_projection.h"
 #include "event_touches.h"
+#include "events.h"
 #include "islands.h"
 #include "regime.h"
 #include "touch_islands.h"
@@ -294,7 +295,7 @@ lc_status lc_event_advance(lc_world *w, lc_event_regime *er, const lc_step_try *
             for (i = 0; i < nimp; ++i)
                 if (t[i].value > 0.0) {
                     w->last.impulses++;
-                    if (lc_push_contact(w, &t[i], LC_CONTACT_COLLISION) != 0) goto oom;
+                    if (lc_record_impact(w, &t[i], LC_IMPACT_EVENT) != 0) goto oom;
                     if (t[i].elasticity < 1.0) {
                         dissipative = 1;
                         last_impact_body = w->is_static[t[i].a] ? t[i].b : t[i].a;
@@ -358,4 +359,14 @@ lc_status lc_event_advance(lc_world *w, lc_event_regime *er, const lc_step_try *
     return LC_OK;
 oom:
     return lc_step_undo(w, step, LC_ERR_NO_MEMORY, "out of memory during the step");
+}
+
+void lc_event_regime_save(const lc_event_regime *er, const lc_world *w, struct lc_writer *out)
+{
+    lc_event_touches_save(er->touches, w, out);
+}
+
+int lc_event_regime_load(lc_event_regime *er, const lc_world *w, struct lc_reader *in)
+{
+    return lc_event_touches_load(er->touches, w, in);
 }

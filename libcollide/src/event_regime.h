@@ -15,6 +15,13 @@ void lc_event_regime_rows_shifted(lc_event_regime *er);
 /* The touches kept at the end of the last event pass no longer describe the state (the contact regime
  * moved bodies since). */
 void lc_event_regime_forget_end(lc_event_regime *er);
+/* Snapshots (snapshot.c): what the regime keeps from one step to the next (event_touches.h), written, and
+ * read back into a new world's (w: its bodies already loaded). Load: 0, or -1 without memory (bad input:
+ * in->bad). */
+struct lc_writer;
+struct lc_reader;
+void lc_event_regime_save(const lc_event_regime *er, const lc_world *w, struct lc_writer *out);
+int lc_event_regime_load(lc_event_regime *er, const lc_world *w, struct lc_reader *in);
 
 /* Advances the dynamic rows[0..nrows) from time t0 by dt (the rest of the step `step` tries), every other
  * dynamic body left out of its pairs (w->excluded). With `handover` non-NULL it stops at the first

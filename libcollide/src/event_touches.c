@@ -6,6 +6,8 @@
 #include <string.h>
 #include "world.h"
 #include "event_touches.h"
+#include "events.h"
+#include "snapshot_io.h"
 
 struct lc_event_touches {
     lc_buf pairs;          /* the broad phase's pairs of a search */
@@ -196,7 +198,7 @@ int lc_event_resting(lc_world *w, lc_event_touches *et, double *state, int *impa
         for (i = 0; i < n; ++i) {
             if (x[i].value > 0.0) {
                 w->last.impulses++;
-                if (lc_push_contact(w, &x[i], LC_CONTACT_COLLISION) != 0) return -1;
+                if (lc_record_impact(w, &x[i], LC_IMPACT_EVENT) != 0) return -1;
             }
             lc_touch_update(w, state, &t[i]);
         }
@@ -309,4 +311,39 @@ int lc_event_impact_group(lc_world *w, lc_event_touches *et, const double *state
     }
     *out = (lc_touch *)et->impact.p;
     return n;
+}
+
+void lc_event_touches_save(const lc_event_touches *et, const lc_world *w, lc_writer *out)
+{
+    int i, end = et->end_count;
+    lc_put_i32(out, et->warm_count);
+    for (i = 0; i < et->warm_count; ++i) lc_put_touch(out, &((const lc_touch *)et->warm.p)[i]);
+    /* end touches kept before an API change are never taken (kept_end_touches): written as none */
+    if (et->end_edits != w->edits) end = -1;
+    lc_put_i32(out, end);
+    if (end < 0) return;
+    lc_put_u64(out, et->end_edits);
+    for (i = 0; i < end; ++i) lc_put_touch(out, &((const lc_touch *)et->end_touches.p)[i]);
+    for (i = 0; i < w->count * 6; ++i) lc_put_f64(out, ((const double *)et->end_state.p)[i]);
+}
+
+int lc_event_touches_load(lc_event_touches *et, const lc_world *w, lc_reader *in)
+{
+    int n = lc_get_count(in, 0, 1 << 28, LC_TOUCH_BYTES, "the warm-start touches"), i;
+    lc_touch *t = lc_buf_get(&et->warm, (size_t)(n > 0 ? n : 1) * sizeof(lc_touch));
+    double *st;
+    if (t == NULL) return -1;
+    for (i = 0; i < n; ++i) lc_get_touch(in, w, &t[i]);
+    et->warm_count = in->bad ? 0 : n;
+    et->end_count = -1;
+    n = lc_get_count(in, -1, 1 << 28, LC_TOUCH_BYTES, "the kept end touches");
+    if (n < 0 || in->bad) return 0;
+    et->end_edits = (unsigned long)lc_get_u64(in);
+    t = lc_buf_get(&et->end_touches, (size_t)(n > 0 ? n : 1) * sizeof(lc_touch));
+    st = lc_buf_get(&et->end_state, (size_t)(w->count > 0 ? w->count : 1) * 6 * sizeof(double));
+    if (t == NULL || st == NULL) return -1;
+    for (i = 0; i < n; ++i) lc_get_touch(in, w, &t[i]);
+    for (i = 0; i < w->count * 6; ++i) st[i] = lc_get_f64(in);
+    if (!in->bad) et->end_count = n;
+    return 0;
 }

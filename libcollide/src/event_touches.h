@@ -40,4 +40,11 @@ int lc_event_touches_end(const lc_event_touches *et, const lc_touch **t);
 /* The kept end touches no longer describe the end state (another regime moved bodies). */
 void lc_event_touches_forget_end(lc_event_touches *et);
 
+/* Snapshots (snapshot.c): the last pass's warm start and the kept end touches, written, and read back
+ * into a new world's (w: its bodies already loaded). Load: 0, or -1 without memory (bad input: in->bad). */
+struct lc_writer;
+struct lc_reader;
+void lc_event_touches_save(const lc_event_touches *et, const lc_world *w, struct lc_writer *out);
+int lc_event_touches_load(lc_event_touches *et, const lc_world *w, struct lc_reader *in);
+
 #endif

@@ -3,6 +3,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "kept_touches.h"
+#include "snapshot_io.h"
 
 typedef struct record {
     int first_row, nrows, npairs, ntouch;
@@ -166,4 +167,73 @@ int lc_kept_touches_take(const lc_kept_touches *k, const lc_world *w, const lc_i
         }
     }
     return n;
+}
+
+void lc_kept_touches_save(const lc_kept_touches *k, const lc_world *w, lc_writer *out)
+{
+    const arena *x = &k->a[1 - k->read];
+    const record *rec = (const record *)x->records.p;
+    int r, i, n = 0;
+    /* a set kept before an API change is never taken (its edits differ): written are the others, whose
+     * rows are the world's */
+    for (r = 0; r < x->nrecords; ++r) n += rec[r].edits == w->edits;
+    lc_put_i32(out, n);
+    for (r = 0; r < x->nrecords; ++r) {
+        if (rec[r].edits != w->edits) continue;
+        const int *in = (const int *)x->ints.p + rec[r].int_at;
+        const double *st = (const double *)x->states.p + rec[r].state_at;
+        const lc_touch *t = (const lc_touch *)x->touches.p + rec[r].touch_at;
+        lc_put_i32(out, rec[r].nrows);
+        lc_put_i32(out, rec[r].npairs);
+        lc_put_i32(out, rec[r].ntouch);
+        lc_put_f64(out, rec[r].dt);
+        lc_put_u64(out, rec[r].edits);
+        for (i = 0; i < rec[r].nrows + 2 * rec[r].npairs; ++i) lc_put_i32(out, in[i]);
+        for (i = 0; i < rec[r].nrows * 6 + rec[r].npairs; ++i) lc_put_f64(out, st[i]);
+        for (i = 0; i < rec[r].ntouch; ++i) lc_put_touch(out, &t[i]);
+    }
+}
+
+int lc_kept_touches_load(lc_kept_touches *k, const lc_world *w, lc_reader *in)
+{
+    arena *x = &k->a[1 - k->read];
+    int nrec = lc_get_count(in, 0, 1 << 28, 32, "the kept touch sets"), r, i;
+    arena_empty(x);
+    for (r = 0; r < nrec && !in->bad; ++r) {
+        int nrows = lc_get_count(in, 1, w->count, 52, "a kept set's rows");
+        int npairs = lc_get_count(in, 0, 1 << 28, 16, "a kept set's pairs");
+        int ntouch = lc_get_count(in, 0, 1 << 28, LC_TOUCH_BYTES, "a kept set's touches");
+        record *rec = lc_buf_get(&x->records, (size_t)(x->nrecords + 1) * sizeof(record));
+        lc_touch *tt = lc_buf_get(&x->touches, (x->ntouches + (size_t)ntouch + 1) * sizeof(lc_touch));
+        double *st = lc_buf_get(&x->states, (x->nstates + (size_t)nrows * 6 + (size_t)npairs + 1) * sizeof(double));
+        int *ints = lc_buf_get(&x->ints, (x->nints + (size_t)nrows + 2 * (size_t)npairs + 1) * sizeof(int));
+        if (rec == NULL || tt == NULL || st == NULL || ints == NULL) return -1;
+        if (in->bad) break;
+        rec += x->nrecords;
+        rec->nrows = nrows;
+        rec->npairs = npairs;
+        rec->ntouch = ntouch;
+        rec->dt = lc_get_f64(in);
+        rec->edits = (unsigned long)lc_get_u64(in);
+        rec->touch_at = x->ntouches;
+        rec->state_at = x->nstates;
+        rec->int_at = x->nints;
+        ints += x->nints;
+        for (i = 0; i < nrows + 2 * npairs; ++i) {
+            ints[i] = lc_get_i32(in);
+            if (ints[i] < 0 || ints[i] >= w->count || (i > 0 && i < nrows && ints[i] <= ints[i - 1]))
+                lc_reader_fail(in, "a kept set's rows or pairs are not rows of the world in order");
+        }
+        rec->first_row = ints[0];
+        st += x->nstates;
+        for (i = 0; i < nrows * 6 + npairs; ++i) st[i] = lc_get_f64(in);
+        tt += x->ntouches;
+        for (i = 0; i < ntouch; ++i) lc_get_touch(in, w, &tt[i]);
+        if (in->bad) break;
+        x->nrecords++;
+        x->ntouches += (size_t)ntouch;
+        x->nstates += (size_t)nrows * 6 + (size_t)npairs;
+        x->nints += (size_t)nrows + 2 * (size_t)npairs;
+    }
+    return 0;
 }

@@ -35,4 +35,12 @@ int lc_kept_touches_store(lc_kept_touches *k, const lc_world *w, const lc_island
 int lc_kept_touches_take(const lc_kept_touches *k, const lc_world *w, const lc_island *isl, double dt,
                          double (*want)(const void *ctx, int a, int b), const void *ctx, lc_buf *buf);
 
+/* Snapshots (snapshot.c): the sets stored since lc_kept_touches_next_step that the next step may take
+ * (kept at the world's current `edits`), written, and read back into an empty store of a new world (w: its bodies already loaded). Load: 0, or
+ * -1 without memory (bad input: in->bad). */
+struct lc_writer;
+struct lc_reader;
+void lc_kept_touches_save(const lc_kept_touches *k, const lc_world *w, struct lc_writer *out);
+int lc_kept_touches_load(lc_kept_touches *k, const lc_world *w, struct lc_reader *in);
+
 #endif

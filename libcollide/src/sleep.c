@@ -4,6 +4,7 @@
 #include <string.h>
 #include "sleep.h"
 #include "world.h"
+#include "snapshot_io.h"
 
 struct lc_sleep {
     int n;                   /* rows the arrays describe */
@@ -156,5 +157,49 @@ int lc_sleep_end_step(lc_sleep *s, lc_world *w, const lc_islands *is, double dt)
             }
     for (i = 0, nk = 0; i < w->count; ++i) nk += asleep[i];
     w->last.bodies_asleep = (uint64_t)nk;
+    return 0;
+}
+
+void lc_sleep_save(const lc_sleep *s, lc_writer *out)
+{
+    const lc_contact *kept = (const lc_contact *)s->b_kept.p;
+    int i;
+    lc_put_i32(out, s->n);
+    lc_put_u64(out, s->changes);
+    lc_put_i32(out, s->any);
+    for (i = 0; i < s->n; ++i) {
+        lc_put_u8(out, ((const uint8_t *)s->b_asleep.p)[i]);
+        lc_put_f64(out, ((const double *)s->b_rest.p)[i]);
+    }
+    lc_put_i32(out, s->nkept);
+    for (i = 0; i < s->nkept; ++i) lc_put_contact(out, &kept[i]);
+}
+
+int lc_sleep_load(lc_sleep *s, const lc_world *w, lc_reader *in)
+{
+    int n = lc_get_count(in, 0, 1 << 24, 9, "the sleep records"), i, rows = n > w->count ? n : w->count;
+    uint8_t *asleep;
+    double *rest;
+    lc_contact *kept;
+    s->changes = (unsigned long)lc_get_u64(in);
+    s->any = lc_get_i32(in);
+    asleep = lc_buf_get(&s->b_asleep, (size_t)(rows > 0 ? rows : 1));
+    rest = lc_buf_get(&s->b_rest, (size_t)(rows > 0 ? rows : 1) * sizeof(double));
+    if (asleep == NULL || rest == NULL) return -1;
+    memset(asleep, 0, (size_t)(rows > 0 ? rows : 1));
+    memset(rest, 0, (size_t)(rows > 0 ? rows : 1) * sizeof(double));
+    s->n = n;
+    for (i = 0; i < n; ++i) {
+        asleep[i] = (uint8_t)lc_get_u8(in);
+        rest[i] = lc_get_finite(in, "a rest timer");
+        if (asleep[i] > 1) lc_reader_fail(in, "row %d's sleep flag is %u", i, (unsigned)asleep[i]);
+    }
+    if (s->any != 0 && s->any != 1) lc_reader_fail(in, "the sleep flag is %d", s->any);
+    s->nkept = 0;
+    n = lc_get_count(in, 0, 1 << 30, 64, "the sleeping contacts");
+    kept = lc_buf_get(&s->b_kept, (size_t)(n > 0 ? n : 1) * sizeof(lc_contact));
+    if (kept == NULL) return -1;
+    for (i = 0; i < n && !in->bad; ++i) lc_get_contact(in, &kept[i]);
+    s->nkept = in->bad ? 0 : n;
     return 0;
 }

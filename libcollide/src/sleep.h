@@ -35,4 +35,10 @@ int lc_sleep_island(lc_sleep *s, struct lc_world *w, const lc_island *isl);
  * islands of the step (is; NULL: the step built none) whose bodies all rested long enough, and appends
  * the kept contacts of every sleeping body to the step's contacts. 0, or -1 without memory. */
 int lc_sleep_end_step(lc_sleep *s, struct lc_world *w, const struct lc_islands *is, double dt);
+/* Snapshots (snapshot.c): who sleeps, the rest timers and the sleeping contacts, written, and read back
+ * into a new world's (w: its bodies already loaded). Load: 0, or -1 without memory (bad input: in->bad). */
+struct lc_writer;
+struct lc_reader;
+void lc_sleep_save(const lc_sleep *s, struct lc_writer *out);
+int lc_sleep_load(lc_sleep *s, const struct lc_world *w, struct lc_reader *in);
 #endif

@@ -11,6 +11,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include "snapshot_io.h"
 #include "world.h"
 #include "tunables.h"
 
@@ -364,4 +365,22 @@ int lc_sparse_lcp(lc_world *w, const lc_touch *t, int m, int tangent, const doub
     *violation = worst;
     w->last.solver_work += (uint64_t)products * (uint64_t)m * LC_SPARSE_ROW_ENTRIES;
     return products;
+}
+
+void lc_sparse_lcp_save(const lc_sparse_lcp_state *sp, lc_writer *out)
+{
+    int k;
+    for (k = 0; k < 2; ++k) {
+        lc_put_f64(out, sp->norm[k]);
+        lc_put_i32(out, sp->norm_rows[k]);
+    }
+}
+
+void lc_sparse_lcp_load(lc_sparse_lcp_state *sp, lc_reader *in)
+{
+    int k;
+    for (k = 0; k < 2; ++k) {
+        sp->norm[k] = lc_get_f64(in);
+        sp->norm_rows[k] = lc_get_i32(in);
+    }
 }

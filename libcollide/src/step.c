@@ -9,6 +9,7 @@
 #include "world.h"
 #include "contact_regime.h"
 #include "event_regime.h"
+#include "events.h"
 #include "islands.h"
 #include "regime.h"
 #include "sleep.h"
@@ -43,6 +44,7 @@ lc_status lc_step_undo(lc_world *w, const lc_step_try *step, lc_status s, const 
     memcpy(w->state, step->start, (size_t)w->count * 6 * sizeof(double));
     w->time = step->time0;
     w->contact_count = 0;
+    lc_events_unstage(w->events, 0);
     return lc_fail(w, s, "%s; the step was undone", what);
 }
 
@@ -180,6 +182,7 @@ static void restart_step(lc_world *w, const double *backup, const uint8_t *marks
     memcpy(w->rests_dissipative, marks0, (size_t)w->count);
     w->time = time0;
     w->contact_count = 0;
+    lc_events_unstage(w->events, 0);   /* the try's impacts happen again, or not, in the next */
     lc_contact_regime_retry(w->contact);
 }
 
@@ -203,6 +206,7 @@ lc_status lc_world_step(lc_world *w, double dt)
     w->last.steps = 1;
     w->step_dt = dt;
     w->contact_count = 0;
+    lc_events_unstage(w->events, 0);
     time0 = w->time;
     bytes = (size_t)(w->count > 0 ? w->count : 1) * 6 * sizeof(double);
     backup = lc_buf_get(&ss->start, bytes);
@@ -250,6 +254,7 @@ lc_status lc_world_step(lc_world *w, double dt)
         st = advance_islands(w, &step, dt, reach, &marks_known, &stuck, &built);
         if (st != LC_OK) {
             memcpy(w->rests_dissipative, marks0, (size_t)w->count);
+            lc_events_unstage(w->events, 0);
             return st;
         }
         if (built && try < LC_MAX_ISLAND_TRIES - 1) {
@@ -282,6 +287,7 @@ lc_status lc_world_step(lc_world *w, double dt)
     /* islands that rested long enough fall asleep */
     if (lc_sleep_end_step(w->sleep, w, w->islands, dt) != 0)
         return lc_step_undo(w, &step, LC_ERR_NO_MEMORY, "out of memory during the step");
+    lc_events_commit(w->events);   /* the step is taken: its impacts are reported */
     lc_stage_end(w, &w->last.time_step, w->step_t0);
     lc_counters_add(&w->total, &w->last);
     w->error[0] = '\0';

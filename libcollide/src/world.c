@@ -14,6 +14,7 @@
 #include "islands.h"
 #include "contact_regime.h"
 #include "event_regime.h"
+#include "events.h"
 
 /* ---- scratch and errors ------------------------------------------------------------------ */
 
@@ -65,6 +66,7 @@ const char *lc_status_string(lc_status status)
     case LC_ERR_NO_MEMORY: return "out of memory";
     case LC_ERR_NUMERIC: return "numerical failure";
     case LC_ERR_BAD_ENUM: return "unknown enum value";
+    case LC_ERR_BAD_SNAPSHOT: return "bad snapshot";
     }
     return "unknown status";
 }
@@ -107,6 +109,7 @@ lc_world_def lc_default_world_def(void)
     d.allow_sleep = 0;
     d.sleep_time = 0.5;
     d.sleep_speed = 1e-4;
+    d.event_capacity = 4096;
     return d;
 }
 
@@ -180,6 +183,7 @@ static lc_status validate_world_def(lc_world *w, const lc_world_def *d)
     if (!(d->sleep_time > 0.0 && d->sleep_time <= 1e6))
         return lc_fail(w, LC_ERR_OUT_OF_RANGE, "sleep_time = %g is outside (0, 1e6] s", d->sleep_time);
     LC_CHECK_RANGE(w, d->sleep_speed, 0.0, 10.0, "sleep_speed");
+    LC_CHECK_IRANGE(w, d->event_capacity, 0, 1000000, "event_capacity");
     return LC_OK;
 }
 
@@ -217,7 +221,8 @@ lc_world *lc_world_create(const lc_world_def *def, char *errbuf, size_t errbuf_l
         w->static_load = lc_static_load_state_create();
         w->sleep = lc_sleep_create();
         w->lcp = lc_lcp_workspace_create();
-        if (!w->step_state || !w->islands || !w->event || !w->contact || !w->broad_phase || !w->integrator ||
+        w->events = lc_events_create(def->event_capacity);
+        if (!w->events || !w->step_state || !w->islands || !w->event || !w->contact || !w->broad_phase || !w->integrator ||
             !w->contact_forces || !w->impulse || !w->sparse_lcp || !w->static_load || !w->sleep || !w->lcp)
             s = lc_fail(w, LC_ERR_NO_MEMORY, "out of memory");
     }
@@ -252,6 +257,7 @@ void lc_world_destroy(lc_world *w)
     lc_static_load_state_destroy(w->static_load);
     lc_sleep_destroy(w->sleep);
     lc_lcp_workspace_destroy(w->lcp);
+    lc_events_destroy(w->events);
     lc_buf_free(&w->b_pairs);
     lc_buf_free(&w->b_touch);
     free(w);
@@ -273,6 +279,7 @@ lc_status lc_world_set_def(lc_world *w, const lc_world_def *def)
     s = validate_world_def(w, def);
     if (s != LC_OK) return s;
     w->def = *def;
+    lc_events_set_capacity(w->events, def->event_capacity);
     return lc_changed(w);
 }
 

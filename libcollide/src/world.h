@@ -113,6 +113,7 @@ struct lc_world {
     struct lc_sparse_lcp_state *sparse_lcp;         /* sparse_lcp.c */
     struct lc_static_load_state *static_load;       /* static_load.c */
     struct lc_sleep *sleep;                         /* sleep.c */
+    struct lc_events *events;                       /* events.c: the impact event stream */
     /* the dense solver's workspace (lcp.c), shared by the dense solves of contact_forces.c, impulse.c and
      * event_projection.c: scratch that no solve holds past its return */
     lc_lcp_workspace *lcp;
@@ -173,6 +174,11 @@ static inline lc_status lc_changed(lc_world *w)
     w->error[0] = '\0';
     return LC_OK;
 }
+
+/* ---- body.c ---- */
+/* Room for `bodies` rows and for body id `id` in the id map (-1 for ids not given). 1, or 0 without
+ * memory. */
+int lc_world_reserve(lc_world *w, int bodies, lc_body_id id);
 
 /* ---- spring.c ---- */
 /* Drops the springs attached to body `id` (lc_world_remove_body). */
@@ -286,6 +292,11 @@ void lc_sparse_lcp_state_destroy(lc_sparse_lcp_state *sp);
  * (round-off past its matrix's scale) stops with the best iterate it kept. */
 int lc_sparse_lcp(lc_world *w, const lc_touch *t, int m, int tangent, const double *b, const double *lo,
                   const double *hi, double *x, double tol, int max_products, double *violation);
+/* Snapshots (snapshot.c): the ||A|| estimates kept across solves. */
+struct lc_writer;
+struct lc_reader;
+void lc_sparse_lcp_save(const lc_sparse_lcp_state *sp, struct lc_writer *out);
+void lc_sparse_lcp_load(lc_sparse_lcp_state *sp, struct lc_reader *in);
 
 /* ---- static_load.c ---- */
 typedef struct lc_static_load_state lc_static_load_state;

@@ -18,6 +18,7 @@ _EXPORTS = {
     "World": "world", "Energy": "world", "WALL_NAMES": "world",
     "Body": "body", "Spring": "body", "Thruster": "body",
     "CONTACT_DTYPE": "_views", "COLLISION": "_views", "RESTING": "_views",
+    "EVENT_DTYPE": "_views", "IMPACT_EVENT": "_views", "IMPACT_CONTACT": "_views",
     "RayHit": "query", "BodyDistance": "query",
 }
 __all__ = sorted(_EXPORTS) + ["version"]

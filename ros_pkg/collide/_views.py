@@ -1,4 +1,5 @@
-"""Zero-copy, read-only numpy views of C memory, and the structured dtype of lc_contact."""
+"""Zero-copy, read-only numpy views of C memory, and the structured dtypes of lc_contact and
+lc_impact_event."""
 from __future__ import annotations
 
 from typing import Any
@@ -10,29 +11,35 @@ from ._ffi import ffi, lib
 
 COLLISION = int(lib.LC_CONTACT_COLLISION)
 RESTING = int(lib.LC_CONTACT_RESTING)
+IMPACT_EVENT = int(lib.LC_IMPACT_EVENT)      # an impact the event regime resolved at its own time
+IMPACT_CONTACT = int(lib.LC_IMPACT_CONTACT)  # an impact the contact regime resolved at a (sub-)step's start
 
 
-def _contact_dtype() -> np.dtype:
-    """Structured dtype with the exact offsets and size of C's lc_contact."""
-    kind_size = ffi.sizeof("lc_contact_kind")
-    fields = {
-        "body_a": np.uint32, "body_b": np.uint32, "point": (np.float64, (2,)), "normal": (np.float64, (2,)),
-        "gap": np.float64, "normal_velocity": np.float64, "impulse": np.float64,
-        "tangent_impulse": np.float64, "force": np.float64, "time": np.float64,
-        "kind": np.dtype(f"i{kind_size}"),
-    }
-    c_fields = [name for name, _ in ffi.typeof("lc_contact").fields]
+def _struct_dtype(ctype: str, fields: dict[str, Any]) -> np.dtype:
+    """Structured dtype with the exact offsets and size of the C struct ctype."""
+    c_fields = [name for name, _ in ffi.typeof(ctype).fields]
     if c_fields != list(fields):
-        raise ImportError(f"lc_contact fields changed: {c_fields}; update collide.world")
+        raise ImportError(f"{ctype} fields changed: {c_fields}; update collide._views")
     return np.dtype({
         "names": list(fields),
         "formats": list(fields.values()),
-        "offsets": [ffi.offsetof("lc_contact", n) for n in fields],
-        "itemsize": ffi.sizeof("lc_contact"),
+        "offsets": [ffi.offsetof(ctype, n) for n in fields],
+        "itemsize": ffi.sizeof(ctype),
     })
 
 
-CONTACT_DTYPE = _contact_dtype()
+CONTACT_DTYPE = _struct_dtype("lc_contact", {
+    "body_a": np.uint32, "body_b": np.uint32, "point": (np.float64, (2,)), "normal": (np.float64, (2,)),
+    "gap": np.float64, "normal_velocity": np.float64, "impulse": np.float64,
+    "tangent_impulse": np.float64, "force": np.float64, "time": np.float64,
+    "kind": np.dtype(f"i{ffi.sizeof('lc_contact_kind')}"),
+})
+
+EVENT_DTYPE = _struct_dtype("lc_impact_event", {
+    "time": np.float64, "body_a": np.uint32, "body_b": np.uint32, "point": (np.float64, (2,)),
+    "normal": (np.float64, (2,)), "normal_impulse": np.float64, "tangent_impulse": np.float64,
+    "approach_speed": np.float64, "kind": np.dtype(f"i{ffi.sizeof('lc_impact_kind')}"),
+})
 
 
 class _Keeper:

@@ -13,13 +13,13 @@ import numpy as np
 
 from . import _convert as cv
 from ._ffi import CollideError, check, ffi, lib
-from ._views import COLLISION, CONTACT_DTYPE, RESTING, _view
+from ._views import COLLISION, CONTACT_DTYPE, EVENT_DTYPE, IMPACT_CONTACT, IMPACT_EVENT, RESTING, _view
 from .body import Body, BodyRef, Spring, Thruster, _Record, _vec
 from . import query as _query
 from .query import BodyDistance, RayHit
 
 __all__ = ["World", "Body", "Thruster", "Spring", "Energy", "CollideError", "CONTACT_DTYPE",
-           "COLLISION", "RESTING", "WALL_NAMES"]
+           "COLLISION", "RESTING", "EVENT_DTYPE", "IMPACT_EVENT", "IMPACT_CONTACT", "WALL_NAMES"]
 
 WALL_NAMES = ("wall_bottom", "wall_right", "wall_top", "wall_left")  # lc_world_add_walls order
 
@@ -319,6 +319,34 @@ class World:
         check(self._w, lib.lc_world_get_contacts(self._w, out, count))
         return _view(self, out[0], (count[0],), CONTACT_DTYPE)
 
+    def read_events(self, max_count: int | None = None) -> tuple[np.ndarray, int]:
+        """The impacts of the steps since the last read, oldest first, removed from the stream
+        (lc_world_get_events): (events, dropped). events is an EVENT_DTYPE array (a copy) of at most
+        max_count rows (None: all unread); dropped counts the oldest events the stream let go since the
+        last read because more than the world's event_capacity were unread."""
+        pending = ffi.new("int *")
+        dropped = ffi.new("uint64_t *")
+        if max_count is None:
+            check(self._w, lib.lc_world_get_events(self._w, ffi.NULL, 0, pending, ffi.NULL))
+            cap = pending[0]
+        else:
+            cap = cv.integer(max_count, "max_count")
+            if not 0 <= cap < 2**31:
+                raise ValueError(f"max_count must be in [0, 2**31), got {cap}")
+        out = np.zeros(cap, dtype=EVENT_DTYPE)
+        if cap == 0:  # nothing to read: the C call with capacity 0 is a size query and clears nothing
+            return out, 0
+        check(self._w, lib.lc_world_get_events(self._w, ffi.cast("lc_impact_event *", ffi.from_buffer(out)), cap,
+                                               pending, dropped))
+        return out[: pending[0]], int(dropped[0])
+
+    @property
+    def pending_events(self) -> int:
+        """Unread impact events (read_events returns them)."""
+        pending = ffi.new("int *")
+        check(self._w, lib.lc_world_get_events(self._w, ffi.NULL, 0, pending, ffi.NULL))
+        return int(pending[0])
+
     @property
     def energy(self) -> Energy:
         e = ffi.new("lc_energy *")
@@ -348,6 +376,48 @@ class World:
 
     def state_hash(self) -> int:
         return int(lib.lc_world_state_hash(self._w))
+
+    # ---- snapshots (lc_world_save / lc_world_load, docs/events_and_snapshots.md) -------------------
+    def save(self) -> bytes:
+        """A snapshot of the world: loaded into any World (load, from_snapshot), it steps on bit for bit
+        as this one does. Body and spring names are Python's and are not in it."""
+        size = ffi.new("size_t *")
+        check(self._w, lib.lc_world_save(self._w, ffi.NULL, 0, size))
+        buf = ffi.new("unsigned char[]", max(int(size[0]), 1))
+        check(self._w, lib.lc_world_save(self._w, buf, size[0], size))
+        return bytes(ffi.buffer(buf, size[0]))
+
+    def load(self, data: bytes | bytearray | memoryview) -> None:
+        """Replace everything in this world by a snapshot (save). A body id this world names keeps its
+        name, the others are named body<id>; unread impact events go. A truncated or corrupt snapshot
+        raises CollideError (LC_ERR_BAD_SNAPSHOT) and leaves the world as it was."""
+        if not isinstance(data, (bytes, bytearray, memoryview)):
+            raise TypeError(f"a snapshot is bytes, got {type(data).__name__}")
+        raw = bytes(data)
+        check(self._w, lib.lc_world_load(self._w, raw, len(raw)))
+        self._after_load()
+
+    @classmethod
+    def from_snapshot(cls, data: bytes | bytearray | memoryview) -> "World":
+        """A new World loaded from a snapshot (save); bodies are named body<id>."""
+        w = cls()
+        w.load(data)
+        return w
+
+    def _after_load(self) -> None:
+        old = {i: r.name for i, r in self._rec.items()}
+        self._rec, self._by_name = {}, {}
+        ids = [int(i) for i in self.ids]
+        for i in ids:  # the kept names first, so a default name cannot take one
+            if i in old:
+                self._rec[i] = _Record(old[i])
+                self._by_name[old[i]] = i
+        for i in ids:
+            if i not in self._rec:
+                self._register(i, None, sync=False)
+        self._sync_names()
+        self._springs = {n: s for n, s in self._springs.items() if self._spring_alive(s)}
+        self._poly_cache = None
 
     # ---- springs ---------------------------------------------------------------------------------
     def _spring_alive(self, spring_id: int) -> bool:

@@ -123,7 +123,7 @@ def test_headers_are_read() -> None:
     assert api.structs["lc_vec2"] == ["x", "y"]
     assert "sleep_speed" in api.structs["lc_world_def"] and "center_of_mass" in api.structs["lc_body_def"]
     assert "time_contact_regime" in api.structs["lc_counters"]
-    assert api.enums["lc_status"][-1] == "LC_ERR_BAD_ENUM"
+    assert api.enums["lc_status"][-1] == "LC_ERR_BAD_SNAPSHOT"
     assert {"lc_world", "lc_body_id", "lc_spring_id", "lc_status"} <= api.types
     assert {"LC_API", "LC_WORLD_ANCHOR", "LC_VERSION_STRING"} <= api.macros
 

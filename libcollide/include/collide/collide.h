@@ -146,6 +146,15 @@ LC_API int lc_world_spring_count(const lc_world *world);
 
 /* Contacts of the last step: its impacts and the resting contacts at its end. Valid until the next step. */
 LC_API lc_status lc_world_get_contacts(const lc_world *world, const lc_contact **out, int *out_count);
+/* The impacts of the steps since the last read, oldest first: up to `capacity` of them into out, their
+ * number into *out_count; those are removed from the stream, the rest stay for the next read. Only
+ * steps that were taken report (an undone step reports nothing). The stream keeps at most
+ * lc_world_def.event_capacity unread events: past it the oldest go, and *out_dropped (may be NULL)
+ * receives how many went since the last read that asked for it (then 0 again). With capacity 0 it is a
+ * size query: *out_count = unread events, *out_dropped = drops so far, nothing removed (out may be NULL).
+ * Reading changes nothing a step reads. */
+LC_API lc_status lc_world_get_events(lc_world *world, lc_impact_event *out, int capacity, int *out_count,
+                                     uint64_t *out_dropped);
 /* Energy and momentum of the current state. */
 LC_API lc_status lc_world_get_energy(const lc_world *world, lc_energy *out);
 /* Measure wall time per pipeline stage into the counters' time_* fields (on = 1) or not (0, the default:
@@ -157,6 +166,22 @@ LC_API lc_status lc_world_get_stage_timing(const lc_world *world, int *out);
 LC_API lc_status lc_world_get_counters(const lc_world *world, lc_counters *last, lc_counters *total);
 /* 64-bit FNV-1a hash of time and every body's state bits, for determinism checks. */
 LC_API uint64_t lc_world_state_hash(const lc_world *world);
+
+/* ---- snapshots (docs/events_and_snapshots.md) ------------------------------------------------ */
+
+/* Writes a snapshot of the world into buf[capacity]: everything a later step reads (settings, time,
+ * bodies with their ids, springs, thrusters, what the engine keeps from one step to the next), so a
+ * world loaded from it steps on bit for bit as this one does. Its size (bytes) goes to *out_size; with
+ * buf NULL only the size is computed. A capacity below the size is LC_ERR_OUT_OF_RANGE (with *out_size
+ * the size needed). The format is versioned and little-endian on every machine. */
+LC_API lc_status lc_world_save(const lc_world *world, void *buf, size_t capacity, size_t *out_size);
+/* Replaces everything in the world by the snapshot buf[size] (lc_world_save): its settings, time,
+ * bodies, springs and kept state; its unread impact events go too. Views of its state become invalid,
+ * as after lc_world_remove_body. A truncated, corrupt or unknown snapshot is LC_ERR_BAD_SNAPSHOT and
+ * leaves the world unchanged. The world's stage timing setting is kept. */
+LC_API lc_status lc_world_load(lc_world *world, const void *buf, size_t size);
+/* A new world from a snapshot; on failure NULL, and the reason in errbuf (may be NULL). */
+LC_API lc_world *lc_world_create_from_snapshot(const void *buf, size_t size, char *errbuf, size_t errbuf_len);
 
 #ifdef __cplusplus
 }

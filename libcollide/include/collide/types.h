@@ -34,7 +34,8 @@ typedef enum lc_status {
     LC_ERR_STATIC_BODY = 8,     /* the operation needs a dynamic body */
     LC_ERR_NO_MEMORY = 9,       /* allocation failed */
     LC_ERR_NUMERIC = 10,        /* a step produced a non-finite state; the step was undone */
-    LC_ERR_BAD_ENUM = 11        /* an enum field holds an unknown value */
+    LC_ERR_BAD_ENUM = 11,       /* an enum field holds an unknown value */
+    LC_ERR_BAD_SNAPSHOT = 12    /* a snapshot (lc_world_load) that is truncated, corrupt or of another format */
 } lc_status;
 
 /* Free-flight integrator; the value is its order of accuracy. */
@@ -128,6 +129,8 @@ typedef struct lc_world_def {
     double sleep_time;             /* s a body must rest before its island may sleep, (0, 1e6], default 0.5 */
     double sleep_speed;            /* m/s, a body rests while its centre and its farthest point move slower
                                       than this, [0, 10], default 1e-4 */
+    int event_capacity;            /* most unread impact events kept for lc_world_get_events, [0, 1e6], default
+                                      4096; past it the oldest go (counted); 0: none are kept */
 } lc_world_def;
 
 /* A body. Start from lc_default_body_def(). Vertices are in the body's local frame; the centre of
@@ -202,6 +205,30 @@ typedef struct lc_contact {
     double time;              /* s, world time of the impact or of the reading */
     lc_contact_kind kind;
 } lc_contact;
+
+/* Which regime resolved an impact (docs/contact_regime.md). */
+typedef enum lc_impact_kind {
+    LC_IMPACT_EVENT = 0,   /* the event regime: at the impact's own time, by eq. 11 */
+    LC_IMPACT_CONTACT = 1  /* the contact regime: at the start of the (sub-)step in which the point closed
+                              faster than resting_speed */
+} lc_impact_kind;
+
+/* One impact of the event stream (lc_world_get_events): a contact point that received a collision
+ * impulse. The same numbers as the step's LC_CONTACT_COLLISION contact. body_a owns the vertex, body_b
+ * the edge; the normal points out of body_b. */
+typedef struct lc_impact_event {
+    double time;              /* s, world time of the impact */
+    lc_body_id body_a;
+    lc_body_id body_b;
+    lc_vec2 point;            /* m, world */
+    lc_vec2 normal;           /* unit, world */
+    double normal_impulse;    /* N*s, along the normal, >= 0 */
+    double tangent_impulse;   /* N*s, friction, along (-normal.y, normal.x) */
+    double approach_speed;    /* m/s, the points' approach along the normal before the impact (minus the
+                                 relative normal velocity); <= 0 for a point of a multi-point impact that
+                                 was not approaching itself */
+    lc_impact_kind kind;
+} lc_impact_event;
 
 /* Energy split into translational, rotational, gravitational and spring parts, plus momentum. */
 typedef struct lc_energy {
