@@ -43,6 +43,7 @@ static void poll_collisions(const lc_world *w, evlist *l)
         e.body_b = c[i].body_b;
         e.point = c[i].point;
         e.normal = c[i].normal;
+        e.gap = c[i].gap;
         e.normal_impulse = c[i].impulse;
         e.tangent_impulse = c[i].tangent_impulse;
         e.approach_speed = -c[i].normal_velocity;
@@ -71,7 +72,7 @@ static int same_event(const lc_impact_event *a, const lc_impact_event *b, int wi
 {
     return a->time == b->time && a->body_a == b->body_a && a->body_b == b->body_b && a->point.x == b->point.x &&
            a->point.y == b->point.y && a->normal.x == b->normal.x && a->normal.y == b->normal.y &&
-           a->normal_impulse == b->normal_impulse && a->tangent_impulse == b->tangent_impulse &&
+           a->gap == b->gap && a->normal_impulse == b->normal_impulse && a->tangent_impulse == b->tangent_impulse &&
            a->approach_speed == b->approach_speed && (!with_kind || a->kind == b->kind);
 }
 

@@ -222,6 +222,7 @@ typedef struct lc_impact_event {
     lc_body_id body_b;
     lc_vec2 point;            /* m, world */
     lc_vec2 normal;           /* unit, world */
+    double gap;               /* m, separation along the normal when the impulse was applied */
     double normal_impulse;    /* N*s, along the normal, >= 0 */
     double tangent_impulse;   /* N*s, friction, along (-normal.y, normal.x) */
     double approach_speed;    /* m/s, the points' approach along the normal before the impact (minus the
