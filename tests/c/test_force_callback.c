@@ -2,7 +2,7 @@
  * (same bits), a state-dependent force against closed forms (a harmonic oscillator at RK4's predicted
  * error, and the integrators' orders), mutual gravitation with its potential (energy and momentum), a
  * failing callback (the step undone, the world unchanged), the rules it brings (no sleep, no closed
- * form) and removing it (the old behaviour, bit for bit). */
+ * form), removing it (the old behaviour, bit for bit) and snapshots (which do not hold it). */
 #include <stdlib.h>
 #include "check.h"
 #include "scenes.h"
@@ -499,6 +499,54 @@ static void removal_restores(void)
     lc_world_destroy(wb);
 }
 
+/* A snapshot holds no callback: lc_world_load keeps the world's own, a world created from a snapshot has
+ * none; with the same callback set again, a loaded world steps on bit for bit (the thrown box and a
+ * second one attracting each other over the floor: impacts and the contact regime). */
+static void snapshot_and_callback(void)
+{
+    gravity_law law = {50.0};
+    constant_law other_law = {{1.0, 0.0}, 0.0, 0};
+    lc_body_id box;
+    lc_world *w = throw_scene(0.2, 0.0, &box), *copy, *other = sc_world(NULL);
+    size_t n = 0, m = 0;
+    unsigned char *buf;
+    lc_force_fn f;
+    lc_potential_fn p;
+    void *u;
+    char err[256];
+    uint64_t h;
+    if (!w || !other) return;
+    sc_box(w, 0.5, 0.5, 2.0, 0.25, 0.0, 0.0, 0.0, 0.0, 1.0, 0.2);
+    CHECK(lc_world_set_force_callback(w, gravity_force, gravity_potential, &law) == LC_OK, "%s", "set");
+    sc_step_n(w, 1.0 / 60.0, 60);
+    CHECK(lc_world_save(w, NULL, 0, &n) == LC_OK && n > 0, "%s", "snapshot size");
+    buf = malloc(n);
+    if (buf == NULL) return;
+    CHECK(lc_world_save(w, buf, n, &m) == LC_OK && m == n, "%s", "save");
+    sc_step_n(w, 1.0 / 60.0, 120);
+    h = lc_world_state_hash(w);
+    copy = lc_world_create_from_snapshot(buf, n, err, sizeof err);
+    CHECK(copy != NULL, "create_from_snapshot: %s", err);
+    if (copy != NULL) {
+        CHECK(lc_world_get_force_callback(copy, &f, &p, &u) == LC_OK && f == NULL && p == NULL && u == NULL, "%s",
+              "a world created from a snapshot has no callback");
+        CHECK(lc_world_set_force_callback(copy, gravity_force, gravity_potential, &law) == LC_OK, "%s", "set again");
+        sc_step_n(copy, 1.0 / 60.0, 120);
+        CHECK(lc_world_state_hash(copy) == h, "%s", "created from the snapshot, same callback: the same bits");
+        lc_world_destroy(copy);
+    }
+    CHECK(lc_world_set_force_callback(other, constant_force, NULL, &other_law) == LC_OK, "%s", "set on other");
+    CHECK(lc_world_load(other, buf, n) == LC_OK, "load: %s", lc_world_last_error(other));
+    CHECK(lc_world_get_force_callback(other, &f, &p, &u) == LC_OK && f == constant_force && p == NULL &&
+              u == &other_law, "%s", "lc_world_load keeps the world's own callback");
+    CHECK(lc_world_set_force_callback(other, gravity_force, gravity_potential, &law) == LC_OK, "%s", "set");
+    sc_step_n(other, 1.0 / 60.0, 120);
+    CHECK(lc_world_state_hash(other) == h, "%s", "loaded, same callback: the same bits");
+    free(buf);
+    lc_world_destroy(w);
+    lc_world_destroy(other);
+}
+
 /* Bad calls change nothing and say why. */
 static void bad_calls(void)
 {
@@ -534,6 +582,7 @@ int main(void)
     query_contents();
     no_sleep_with_callback();
     removal_restores();
+    snapshot_and_callback();
     bad_calls();
     return CHECK_SUMMARY("test_force_callback");
 }

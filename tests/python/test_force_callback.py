@@ -240,3 +240,26 @@ def test_bad_arguments_are_refused() -> None:
     with pytest.raises(CollideError, match="potential belongs to a force law") as info:
         w.set_force_callback(None, lambda q: 0.0)
     assert info.value.status == lib.LC_ERR_NULL
+
+
+def test_snapshots_hold_no_callback() -> None:
+    # load keeps the world's own law; a world from a snapshot has none until it is set again, and then
+    # steps on bit for bit (two boxes attracting each other over the floor)
+    force, potential = gravitation(50.0)
+    w, _ = thrown_box(damping=0.0)
+    w.add_box(0.5, 0.5, position=(2.0, 0.25), elasticity=0.2)
+    w.set_force_callback(force, potential)
+    w.step(1.0 / 60.0, 60)
+    snap = w.save()
+    w.step(1.0 / 60.0, 120)
+    copy = World.from_snapshot(snap)
+    assert copy.energy.callback == 0.0                 # no law, no potential
+    copy.set_force_callback(force, potential)
+    copy.step(1.0 / 60.0, 120)
+    assert copy.state_hash() == w.state_hash()
+    other = World()
+    other.set_force_callback(force, potential)
+    other.load(snap)
+    assert other.energy.callback < 0.0                 # the law stayed
+    other.step(1.0 / 60.0, 120)
+    assert other.state_hash() == w.state_hash()
