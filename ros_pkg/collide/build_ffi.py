@@ -3,7 +3,8 @@
 The cdef is not hand-written: it is the output of the C preprocessor run on
 ``libcollide/include/collide/collide.h`` (system headers replaced by empty shims, since cffi
 already knows ``size_t``/``uint32_t``/...), plus one ``#define NAME ...`` line per integer
-constant the headers define, whose value cffi then reads from the compiler.
+constant the headers define, whose value cffi then reads from the compiler. The one hand-written
+part declares the ``extern "Python"`` functions the force callback calls (``EXTERN_PYTHON``).
 
 ``python -m collide.build_ffi`` is idempotent: it rebuilds only when the headers, this file, the
 Python ABI or the library directory changed (a fingerprint of those is embedded in the extension),
@@ -105,12 +106,21 @@ def generate_cdef() -> str:
     return "\n".join(sorted(consts) + lines) + "\n"
 
 
+# The C entry points of the binding's force callbacks (collide/force.py defines them with
+# @ffi.def_extern): cffi compiles them into the extension, so no libffi closure is made at run time.
+EXTERN_PYTHON = """
+extern "Python" int collide_force_callback(void *, const lc_force_query *, double *);
+extern "Python" int collide_potential_callback(void *, const lc_force_query *, double *);
+"""
+
+
 def make_ffibuilder():  # -> cffi.FFI (imported lazily so `import collide` needs no setuptools)
     import cffi
 
     lib_dir = build_dir()
     ffibuilder = cffi.FFI()
     ffibuilder.cdef(generate_cdef())
+    ffibuilder.cdef(EXTERN_PYTHON)
     rel = os.path.relpath(lib_dir, PACKAGE_DIR)
     # The fingerprint of what the extension was built from lives in the binary itself, so a check
     # never trusts a stamp that could belong to another build directory.
