@@ -156,6 +156,7 @@ def write_c_source(target: Path) -> Path:
 
     ffibuilder = cffi.FFI()
     ffibuilder.cdef(generate_cdef())
+    ffibuilder.cdef(EXTERN_PYTHON)
     ffibuilder.set_source(MODULE_NAME, '#include "collide/collide.h"\n')
     target.parent.mkdir(parents=True, exist_ok=True)
     ffibuilder.emit_c_code(str(target))

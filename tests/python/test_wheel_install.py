@@ -27,7 +27,7 @@ WHEELHOUSE = Path(sys.prefix) / "wheelhouse"
 # the binding's suites, run against the installed package; the two tests of test_binding.py that
 # check the source checkout's extension build (python -m collide.build_ffi) do not apply to a wheel
 BINDING_SUITES = ["test_binding.py", "test_binding_physics.py", "test_body_props.py", "test_query.py",
-                  "test_events.py", "test_snapshot.py"]
+                  "test_events.py", "test_snapshot.py", "test_force_callback.py"]
 SOURCE_BUILD_TESTS = ["test_cdef_is_generated_from_the_public_header",
                       "test_build_is_idempotent_and_reports_up_to_date"]
 
