@@ -2,6 +2,7 @@
  * (contact_exact.h). */
 #include <math.h>
 #include <string.h>
+#include "contact_delassus.h"
 #include "contact_exact.h"
 #include "tunables.h"
 
@@ -12,47 +13,6 @@ size_t lc_contact_exact_scratch(int nrows)
     /* A (2m)^2, the unknowns' list, M (n^2), q (n), the tableau n (2n + 2), basis and solution 2n, and
      * for the refinement M without regularization (n^2), its system (n^2) and two vectors (2n) */
     return 4 * m * m + n + n * n + n + n * (2 * n + 2) + 2 * n + 2 * n * n + 2 * n;
-}
-
-/* One Jacobian row: body indices, direction and lever arms. */
-typedef struct jrow {
-    int a, b;
-    double dx, dy, ra, rb;
-} jrow;
-
-static jrow normal_of(const lc_contact_row *r)
-{
-    jrow j;
-    j.a = r->a;
-    j.b = r->b;
-    j.dx = r->nx;
-    j.dy = r->ny;
-    j.ra = r->rna;
-    j.rb = r->rnb;
-    return j;
-}
-
-static jrow tangent_of(const lc_contact_row *r)
-{
-    jrow j;
-    j.a = r->a;
-    j.b = r->b;
-    j.dx = -r->ny;
-    j.dy = r->nx;
-    j.ra = r->rta;
-    j.rb = r->rtb;
-    return j;
-}
-
-/* Entry of A = J M^-1 J^T between two Jacobian rows: the bodies they share. */
-static double response(jrow p, jrow q, const double *inv_mass, const double *inv_inertia)
-{
-    double k = 0.0, dd = p.dx * q.dx + p.dy * q.dy;
-    if (p.a >= 0 && p.a == q.a) k += inv_mass[p.a] * dd + inv_inertia[p.a] * p.ra * q.ra;
-    if (p.a >= 0 && p.a == q.b) k -= inv_mass[p.a] * dd + inv_inertia[p.a] * p.ra * q.rb;
-    if (p.b >= 0 && p.b == q.a) k -= inv_mass[p.b] * dd + inv_inertia[p.b] * p.rb * q.ra;
-    if (p.b >= 0 && p.b == q.b) k += inv_mass[p.b] * dd + inv_inertia[p.b] * p.rb * q.rb;
-    return k;
 }
 
 static void pivot(double *t, int n, int cols, int r, int c)
@@ -255,7 +215,7 @@ int lc_contact_solve_exact(lc_contact_row *rows, int nrows, double *v, const dou
      * problem; a relative 1e-10 on A's diagonal moves the answer by that fraction and almost always
      * ends it, larger ones are the fallbacks (the Gauss-Seidel sweeps that follow take the rest). */
     static const double regularizations[3] = {1e-10, 1e-7, 1e-4};
-    int m = nrows, n = 0, i, j, p = -1, k;
+    int m = nrows, n = 0, i, p = -1, k;
     double *A = scratch, *list_d = A + 4 * m * m, *M, *q, *t, *basis, *z;
     for (i = 0; i < m; ++i) {
         list_d[n++] = 4.0 * i + U_N;
@@ -269,12 +229,7 @@ int lc_contact_solve_exact(lc_contact_row *rows, int nrows, double *v, const dou
     t = q + n;
     basis = t + (size_t)n * (size_t)(2 * n + 2);
     z = basis + n;
-    for (i = 0; i < 2 * m; ++i)
-        for (j = 0; j < 2 * m; ++j) {
-            jrow pi = i < m ? normal_of(&rows[i]) : tangent_of(&rows[i - m]);
-            jrow pj = j < m ? normal_of(&rows[j]) : tangent_of(&rows[j - m]);
-            A[i * 2 * m + j] = response(pi, pj, inv_mass, inv_inertia);
-        }
+    lc_contact_delassus(rows, m, inv_mass, inv_inertia, A);
     for (k = 0; k < 3 && p < 0; ++k) {
         build(rows, m, A, list_d, n, v, regularizations[k], M, q);
         p = lemke(M, q, n, t, basis, z);

@@ -119,6 +119,12 @@
 /* Pivots the exact solver may take per unknown before it gives up (Lemke's pivoting cycles only on
  * degenerate ties, which the lexicographic rule breaks; the cap is a guard). */
 #define LC_LEMKE_PIVOTS_PER_UNKNOWN 20
+/* Rounds of the active-set solve (contact_exact.h) before it gives up: from a stalled Gauss-Seidel answer
+ * a few points change side in the first rounds and the set settles in 2-4 rounds. */
+#define LC_CONTACT_ACTIVE_SET_ITERATIONS 16
+/* Refinements of an active-set solve against the unregularized equations: each takes the error the
+ * 1e-10 regularization left down by that factor again. */
+#define LC_CONTACT_ACTIVE_SET_REFINEMENTS 2
 #ifndef LC_CONTACT_PRECISE_EXACT_POINTS
 #define LC_CONTACT_PRECISE_EXACT_POINTS 32
 #endif

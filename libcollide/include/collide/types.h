@@ -274,7 +274,7 @@ typedef struct lc_counters {
     uint64_t contact_islands;         /* of those, advanced in the contact regime */
     uint64_t contact_points;          /* contact points in the contact regime's solves */
     uint64_t contact_sweeps;          /* Gauss-Seidel sweeps of those solves */
-    uint64_t contact_exact_solves;    /* of those solves, taken exactly by pivoting (few points) */
+    uint64_t contact_exact_solves;    /* of those solves, taken exactly (few points: active sets or pivoting) */
     uint64_t contact_cuts;            /* contact-regime steps cut at a located stick-slip or arrival */
     uint64_t contact_precise_retries; /* contact-regime island steps taken again with converged solves */
     uint64_t energy_clamps;           /* contact-regime island steps whose energy gain was taken back from
