@@ -148,9 +148,13 @@ def test_install_space_has_both_packages(ws: Workspace) -> None:
 
 PROBE = r"""
 import json, sys
+from importlib.metadata import distribution
 from ament_index_python.packages import get_package_prefix, get_package_share_directory
-import collide, collide_ros, collide_ros.node, libcollide_msgs.msg, tf2_msgs.msg
+import collide, collide_ros, libcollide_msgs.msg, tf2_msgs.msg
+scripts = {ep.name: callable(ep.load()) for ep in distribution("collide_ros").entry_points
+           if ep.group == "console_scripts"}
 print(json.dumps({
+    "scripts": scripts,
     "collide_ros": collide_ros.__file__, "libcollide_msgs": libcollide_msgs.msg.__file__,
     "collide": collide.__file__, "tf2_msgs": tf2_msgs.msg.__file__,
     "prefix": get_package_prefix("collide_ros"),
@@ -168,6 +172,8 @@ def test_python_finds_the_packages_in_the_install_space(ws: Workspace) -> None:
     assert got["collide_ros"].startswith(f"{install}/collide_ros/lib/"), got
     assert got["libcollide_msgs"].startswith(f"{install}/libcollide_msgs/lib/"), got
     assert got["prefix"] == f"{install}/collide_ros", got
+    # every executable's entry point imports and names a function
+    assert got["scripts"] == {tool: True for tool in TOOLS}, got
     assert got["msgs_share"] == f"{install}/libcollide_msgs/share/libcollide_msgs", got
     # the binding comes from outside the workspace; tf2_msgs from the underlay (here the venv)
     assert not got["collide"].startswith(install) and not got["tf2_msgs"].startswith(install), got
