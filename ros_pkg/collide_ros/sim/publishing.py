@@ -1,5 +1,5 @@
 """What the node publishes at rates counted in sim-time steps: bodies/poses, bodies/states, contacts and
-energy (state_rate), /tf, markers and /clock. The bulk messages are written as CDR bytes with numpy
+energy (state_rate), /tf, markers and /clock (and the laser scans, scanners.py). The bulk messages are written as CDR bytes with numpy
 (cdr.py, markers.py); the contacts message takes the impacts since the last one from the world's
 impact event stream, which keeps them across steps (docs/events_and_snapshots.md)."""
 from __future__ import annotations
@@ -123,6 +123,8 @@ class Publishing:
             self._publish_tf()
         if self._every_marker and s % self._every_marker == 0:
             self._publish_markers()
+        if self._scanners:
+            self._publish_scans(s)
 
     def _stamp(self) -> tuple[int, int]:
         return cdr.split_time(self.sim_time)
