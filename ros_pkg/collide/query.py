@@ -1,7 +1,8 @@
 """Geometric queries on a World's current poses (the C API of collide/query.h): the bodies at a point or
 sharing a point with a box, ray casts (first hit, or every hit sorted along the ray), and the overlap and
-distance of two bodies, and many rays in one call (a laser scan). Bodies are closed polygons: a point on an edge is in the body, touching counts as
-overlapping. The World methods of the same names call these; see docs/queries.md."""
+distance of two bodies; also the first hits of many rays in one call (a laser scan). Bodies are closed
+polygons: a point on an edge is in the body, touching counts as overlapping. The World methods of the
+same names call these; see docs/queries.md."""
 from __future__ import annotations
 
 from dataclasses import dataclass

@@ -147,7 +147,9 @@ def paused_node(scene: dict[str, Any], path: Path, ns: str) -> Iterator[Run]:
     ctx = rclpy.Context()
     rclpy.init(context=ctx)
     proc = NodeProcess("-r", f"__ns:={ns}", "-p", f"scene_file:={path}", "-p", f"time_step:={DT}",
-                       "-p", "state_rate:=100.0", "-p", "start_paused:=true", "-p", "publish_clock:=false")
+                       "-p", "state_rate:=100.0", "-p", "start_paused:=true", "-p", "publish_clock:=false",
+                       # the writer keeps 10 s of messages for a client starved of CPU (reliable KEEP_LAST)
+                       "-p", "state_qos_depth:=1000")
     client = SimClient(ns, context=ctx, watch=("diagnostics",))
     received: list[Contacts] = []
     deep = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE)

@@ -1,7 +1,8 @@
 """What the node publishes at rates counted in sim-time steps: bodies/poses, bodies/states, contacts and
-energy (state_rate), /tf, markers and /clock (and the laser scans, scanners.py). The bulk messages are written as CDR bytes with numpy
-(cdr.py, markers.py); the contacts message takes the impacts since the last one from the world's
-impact event stream, which keeps them across steps (docs/events_and_snapshots.md)."""
+energy (state_rate), /tf, markers and /clock; the laser scans are scanners.py's. The bulk messages are
+written as CDR bytes with numpy (cdr.py, markers.py); the contacts message takes the impacts since the
+last one from the world's impact event stream, which keeps them across steps
+(docs/events_and_snapshots.md)."""
 from __future__ import annotations
 
 from typing import Any
