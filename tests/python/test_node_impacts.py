@@ -19,7 +19,7 @@ and ``dropped_impacts`` must equal the replay's counts.
   1200 impacts in one step, 1000 in one message and the other 200 first in the next; 1200 resting
   contacts from then on, sent as room allows and the rest dropped.
 - ``test_stream_overflow_is_counted``: the same with ``event_capacity: 500``: of the 1200 the oldest
-  700 go, counted in ``dropped_impacts``.
+  700 go, counted in ``dropped_impacts``; with ``event_capacity: 0`` all 1200.
 """
 from __future__ import annotations
 
@@ -31,6 +31,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import pytest
 import rclpy
 import yaml
 from libcollide_msgs.msg import Contacts
@@ -221,8 +222,8 @@ def test_impacts_past_the_cap_wait(tmp_path: Path) -> None:
     assert exp.dropped_contacts == 1200 + 400 + 4 * 200  # no room, room for 800, then 1000 of 1200 (x4)
 
 
-def test_stream_overflow_is_counted(tmp_path: Path) -> None:
-    capacity = 500
+@pytest.mark.parametrize("capacity", [500, 0])  # 0: the stream keeps none, every impact is dropped
+def test_stream_overflow_is_counted(tmp_path: Path, capacity: int) -> None:
     scene = row_scene(600, event_capacity=capacity)
     with paused_node(scene, tmp_path / "row.yaml", "/impacts_overflow") as run:
         _step(run, 100)

@@ -153,7 +153,9 @@ class Publishing:
         """The impacts since the last publish (the event stream, oldest first, at most
         MAX_CONTACTS_PER_MESSAGE: the rest wait for the next message), then the resting contacts of
         the current step as room allows."""
-        events, dropped = self.world.read_events(MAX_CONTACTS_PER_MESSAGE)
+        # sized to what is unread (a buffer of the cap would be zeroed at every publish), and at least
+        # 1 so that the read reports the drops even when nothing is kept (event_capacity 0)
+        events, dropped = self.world.read_events(min(max(self.world.pending_events, 1), MAX_CONTACTS_PER_MESSAGE))
         self.dropped_impacts += dropped
         impacts = impact_rows(events)
         c = self.world.contacts
