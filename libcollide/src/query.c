@@ -4,6 +4,7 @@
  * throughout; the bodies' cached bounding boxes (broad_phase.c), which bound those vertices exactly,
  * pass over the bodies that cannot answer before any polygon is looked at. */
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include "world.h"
 
@@ -286,6 +287,87 @@ lc_status lc_world_ray_cast_all(const lc_world *world, lc_vec2 start, lc_vec2 en
     if (ah.count > 1 && capacity > 1)
         qsort(out, (size_t)(ah.count < capacity ? ah.count : capacity), sizeof *out, cmp_hit);
     *out_count = ah.count;
+    return LC_OK;
+}
+
+/* ---- many rays at once ------------------------------------------------------------------------ */
+
+/* Ray i of a batch checked as lc_world_ray_cast checks its ray, the message naming the index. */
+static lc_status check_batch_ray(lc_world *w, const lc_vec2 *starts, const lc_vec2 *ends, int i)
+{
+    char name[32];
+    snprintf(name, sizeof name, "starts[%d]", i);
+    LC_TRY(lc_check_vec(w, starts[i], 1e9, name));
+    snprintf(name, sizeof name, "ends[%d]", i);
+    LC_TRY(lc_check_vec(w, ends[i], 1e9, name));
+    if (starts[i].x == ends[i].x && starts[i].y == ends[i].y)
+        return lc_fail(w, LC_ERR_OUT_OF_RANGE, "ray %d has zero length (start = end = (%g, %g))", i, starts[i].x,
+                       starts[i].y);
+    return LC_OK;
+}
+
+static void extend_box(double box[4], lc_vec2 p)
+{
+    box[0] = fmin(box[0], p.x);
+    box[1] = fmin(box[1], p.y);
+    box[2] = fmax(box[2], p.x);
+    box[3] = fmax(box[3], p.y);
+}
+
+lc_status lc_world_ray_cast_batch(const lc_world *world, const lc_vec2 *starts, const lc_vec2 *ends, int count,
+                                  const lc_query_filter *filter, lc_ray_hit *out_hits, int *out_found)
+{
+    lc_world *w = (lc_world *)world;
+    double all[4] = {INFINITY, INFINITY, -INFINITY, -INFINITY};
+    double *bounds;
+    int *rows, nrows = 0, i, k;
+    if (w == NULL) return LC_ERR_NULL;
+    if (count < 0) return lc_fail(w, LC_ERR_OUT_OF_RANGE, "count = %d is negative", count);
+    if (count > 0 && (starts == NULL || ends == NULL || out_hits == NULL || out_found == NULL))
+        return lc_fail(w, LC_ERR_NULL, "starts, ends, out_hits or out_found is NULL with count %d", count);
+    LC_TRY(check_filter(w, filter));
+    for (i = 0; i < count; ++i) {
+        LC_TRY(check_batch_ray(w, starts, ends, i));
+        extend_box(all, starts[i]);
+        extend_box(all, ends[i]);
+    }
+    if (count == 0) return LC_OK;
+    /* The bodies whose box meets the box around every ray, found once: each ray then looks at those
+     * only (a scanner's rays span a few metres of a large world). Same rows in the same order as
+     * cast() visits, so each ray's answer is lc_world_ray_cast's, bit for bit. */
+    rows = malloc((size_t)(w->count > 0 ? w->count : 1) * sizeof *rows);
+    bounds = malloc((size_t)(w->count > 0 ? w->count : 1) * 4 * sizeof *bounds);
+    if (rows == NULL || bounds == NULL) {
+        free(rows);
+        free(bounds);
+        return lc_fail(w, LC_ERR_NO_MEMORY, "out of memory for a batch of %d rays over %d bodies", count, w->count);
+    }
+    for (k = 0; k < w->count; ++k) {
+        if (skipped(w, filter, k)) continue;
+        body_bounds(w, k, bounds + 4 * nrows);
+        if (boxes_overlap(bounds + 4 * nrows, all)) rows[nrows++] = k;
+    }
+    for (i = 0; i < count; ++i) {
+        lc_vec2 d = lc_sub(ends[i], starts[i]);
+        double span[4] = {INFINITY, INFINITY, -INFINITY, -INFINITY};
+        first_hit fh;
+        extend_box(span, starts[i]);
+        extend_box(span, ends[i]);
+        fh.found = 0;
+        for (k = 0; k < nrows; ++k) {
+            polygon p;
+            lc_ray_hit hit;
+            if (!boxes_overlap(bounds + 4 * k, span)) continue;
+            world_polygon(w, rows[k], &p);
+            if (!ray_polygon(&p, starts[i], d, &hit)) continue;
+            hit.body = w->ids[rows[k]];
+            keep_first(&hit, &fh);
+        }
+        out_found[i] = fh.found;
+        if (fh.found) out_hits[i] = fh.best;
+    }
+    free(rows);
+    free(bounds);
     return LC_OK;
 }
 

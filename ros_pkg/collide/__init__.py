@@ -19,7 +19,7 @@ _EXPORTS = {
     "Body": "body", "Spring": "body", "Thruster": "body",
     "CONTACT_DTYPE": "_views", "COLLISION": "_views", "RESTING": "_views",
     "EVENT_DTYPE": "_views", "IMPACT_EVENT": "_views", "IMPACT_CONTACT": "_views",
-    "RayHit": "query", "BodyDistance": "query",
+    "RayHit": "query", "RayHits": "query", "BodyDistance": "query",
     "ForceQuery": "force",
 }
 __all__ = sorted(_EXPORTS) + ["version"]

@@ -1,21 +1,29 @@
 """Geometric queries on a World's current poses (the C API of collide/query.h): the bodies at a point or
 sharing a point with a box, ray casts (first hit, or every hit sorted along the ray), and the overlap and
-distance of two bodies. Bodies are closed polygons: a point on an edge is in the body, touching counts as
-overlapping. The World methods of the same names call these; see docs/queries.md."""
+distance of two bodies; also the first hits of many rays in one call (a laser scan). Bodies are closed
+polygons: a point on an edge is in the body, touching counts as overlapping. The World methods of the
+same names call these; see docs/queries.md."""
 from __future__ import annotations
 
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Iterable
 
+import numpy as np
+from numpy.typing import ArrayLike
+
 from . import _convert as cv
 from ._ffi import check, ffi, lib
+from ._views import _struct_dtype
 from .body import Body, BodyRef, _vec
 
 if TYPE_CHECKING:
     from .world import World
 
-__all__ = ["RayHit", "BodyDistance", "query_point", "query_box", "ray_cast", "ray_cast_all", "body_distance",
-           "bodies_overlap"]
+__all__ = ["RayHit", "RayHits", "BodyDistance", "query_point", "query_box", "ray_cast", "ray_cast_all",
+           "ray_cast_batch", "body_distance", "bodies_overlap"]
+
+_RAY_HIT_DTYPE = _struct_dtype("lc_ray_hit", {"body": np.uint32, "point": (np.float64, (2,)),
+                                              "normal": (np.float64, (2,)), "fraction": np.float64})
 
 
 @dataclass(frozen=True)
@@ -26,6 +34,17 @@ class RayHit:
     point: tuple[float, float]   # m, world: start + fraction * (end - start)
     normal: tuple[float, float]  # unit outward normal of the edge entered; -direction for a ray starting in the body
     fraction: float              # [0, 1] along the ray; 0 when it starts inside or on the body
+
+
+@dataclass(frozen=True)
+class RayHits:
+    """The first hit of each ray of a batch (ray_cast_batch), as arrays indexed by ray."""
+
+    found: np.ndarray     # (n,) bool
+    body: np.ndarray      # (n,) uint32 body id, 0 where nothing was hit
+    point: np.ndarray     # (n, 2) m, world; nan where nothing was hit
+    normal: np.ndarray    # (n, 2) unit; nan where nothing was hit
+    fraction: np.ndarray  # (n,) along each ray, [0, 1]; nan where nothing was hit
 
 
 @dataclass(frozen=True)
@@ -91,6 +110,33 @@ def ray_cast_all(world: World, start: Iterable[float], end: Iterable[float], ski
     args = (cv.vec2(start, "start"), cv.vec2(end, "end"))
     out, n = _listing(world, "lc_ray_hit", lib.lc_world_ray_cast_all, args, skip_static, skip)
     return [_hit(world, out[i]) for i in range(n)]
+
+
+def ray_cast_batch(world: World, starts: ArrayLike, ends: ArrayLike, skip_static: bool = False,
+                   skip: BodyRef | None = None) -> RayHits:
+    """The first hit of each segment from starts[i] to ends[i] ((n, 2) arrays, or one (2,) start for
+    all), in one C call (lc_world_ray_cast_batch): each answer is ray_cast's, bit for bit."""
+    b = np.ascontiguousarray(ends, dtype=np.float64)
+    if b.ndim != 2 or b.shape[1] != 2:
+        raise ValueError(f"ends must be an (n, 2) array, got shape {b.shape}")
+    a0 = np.asarray(starts, dtype=np.float64)
+    if a0.shape not in ((2,), b.shape):
+        raise ValueError(f"starts must be a (2,) point or an array of the shape of ends {b.shape}, got {a0.shape}")
+    a = np.ascontiguousarray(np.broadcast_to(a0, b.shape))
+    n = len(b)
+    if n >= 2**31:
+        raise ValueError(f"at most 2**31 - 1 rays per call, got {n}")
+    f = _filter(world, skip_static, skip)
+    hits = np.zeros(n, dtype=_RAY_HIT_DTYPE)
+    found = np.zeros(n, dtype=np.intc)
+    check(world._w, lib.lc_world_ray_cast_batch(
+        world._w, ffi.cast("lc_vec2 *", ffi.from_buffer(a)), ffi.cast("lc_vec2 *", ffi.from_buffer(b)), n, f,
+        ffi.cast("lc_ray_hit *", ffi.from_buffer(hits)), ffi.cast("int *", ffi.from_buffer(found))))
+    hit = found.astype(bool)
+    point, normal, fraction = hits["point"].copy(), hits["normal"].copy(), hits["fraction"].copy()
+    point[~hit] = normal[~hit] = np.nan
+    fraction[~hit] = np.nan
+    return RayHits(hit, hits["body"].copy(), point, normal, fraction)
 
 
 def body_distance(world: World, a: BodyRef, b: BodyRef) -> BodyDistance:

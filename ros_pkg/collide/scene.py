@@ -344,6 +344,57 @@ def _inertia(v: Any, path: Path_, p: _Parsed) -> Any:
     return val
 
 
+# A laser scanner on a body (read by the ROS node, docs/ros_interface.md "Laser scanners"; the engine
+# ignores it). Defaults: 360 rays, one a degree, from -pi; 10 m; 10 Hz of sim time.
+_SCAN_STEP = 2 * math.pi / 360
+_SCANNER_SPEC = {"name": (_string, _MISSING), "body": (_string, _MISSING), "position": (_vec2, [0.0, 0.0]),
+                 "angle": (_number, 0.0), "angle_min": (_number, -math.pi),
+                 "angle_max": (_number, math.pi - _SCAN_STEP), "angle_increment": (_number, _SCAN_STEP),
+                 "range_min": (_number, 0.0), "range_max": (_number, 10.0), "rate": (_number, 10.0)}
+SCANNER_NAME = re.compile(r"[A-Za-z][A-Za-z0-9_]*")
+MAX_SCAN_RAYS = 10_000
+MAX_SCAN_RANGE = 1e4       # m
+MAX_SCAN_MOUNT = 1e3       # m from the body's centre of mass
+MAX_SCAN_RATE = 1000.0     # Hz of sim time
+
+
+def scanner_problems(sc: Mapping[str, Any]) -> list[tuple[str, str]]:
+    """The (key, reason) of each range rule a scanner's values break (its keys and types already
+    checked); empty when it is usable. Its ray count is scanner_rays(sc)."""
+    out = []
+    if not SCANNER_NAME.fullmatch(sc["name"]):
+        out.append(("name", f"{sc['name']!r} must be a letter then letters, digits or '_' "
+                            "(it names the scanner's topic and frame)"))
+    if max(abs(sc["position"][0]), abs(sc["position"][1])) > MAX_SCAN_MOUNT:
+        out.append(("position", f"{sc['position']} is more than {MAX_SCAN_MOUNT:g} m from the body"))
+    inc, lo, hi = sc["angle_increment"], sc["angle_min"], sc["angle_max"]
+    if not 0 < inc <= 2 * math.pi:
+        out.append(("angle_increment", f"must be in (0, 2*pi] rad, got {inc}"))
+    if not -2 * math.pi <= lo <= hi <= 2 * math.pi:
+        out.append(("angle_max", f"angle_min {lo} <= angle_max {hi} within [-2*pi, 2*pi] rad is required"))
+    elif hi - lo > 2 * math.pi + 1e-12:
+        out.append(("angle_max", f"the scan spans {hi - lo} rad, more than a turn (2*pi)"))
+    elif 0 < inc <= 2 * math.pi:
+        steps = (hi - lo) / inc
+        if round(steps) + 1 > MAX_SCAN_RAYS:
+            out.append(("angle_increment", f"{round(steps) + 1} rays over [angle_min, angle_max]; "
+                                           f"at most {MAX_SCAN_RAYS}"))
+        elif abs(steps - round(steps)) > 1e-6:
+            out.append(("angle_max", f"angle_max - angle_min = {hi - lo} rad is not a whole number of "
+                                     f"angle_increment {inc} ({steps:.6f})"))
+    if not 0 <= sc["range_min"] < sc["range_max"] <= MAX_SCAN_RANGE:
+        out.append(("range_max", f"0 <= range_min ({sc['range_min']}) < range_max ({sc['range_max']}) "
+                                 f"<= {MAX_SCAN_RANGE:g} m is required"))
+    if not 0 < sc["rate"] <= MAX_SCAN_RATE:
+        out.append(("rate", f"must be in (0, {MAX_SCAN_RATE:g}] Hz, got {sc['rate']}"))
+    return out
+
+
+def scanner_rays(sc: Mapping[str, Any]) -> int:
+    """The number of rays of a valid scanner: angle_min, angle_min + angle_increment, ... angle_max."""
+    return int(round((sc["angle_max"] - sc["angle_min"]) / sc["angle_increment"])) + 1
+
+
 _BODY_COMMON = {"name": (_string, _MISSING), "shape": (_string, _MISSING), "position": (_vec2, [0.0, 0.0]),
                 "angle": (_number, 0.0), "velocity": (_vec2, [0.0, 0.0]), "angular_velocity": (_number, 0.0),
                 "mass": (_number, 1.0), "inertia": (_optional(_inertia), None),
@@ -387,6 +438,7 @@ _TOP_SPEC = {"version": (_integer, 1), "description": (_optional(_string), None)
              "walls": (_optional(lambda v, path, p: _mapping(v, path, p, _WALLS_SPEC)), None),
              "bodies": (_list_of(_body), _MISSING),
              "springs": (_list_of(lambda v, path, p: _mapping(v, path, p, _SPRING_SPEC)), []),
+             "scanners": (_list_of(lambda v, path, p: _mapping(v, path, p, _SCANNER_SPEC)), []),
              "run": (lambda v, path, p: _mapping(v, path, p, _RUN_SPEC), dict(dt=0.01, duration=10.0))}
 
 
@@ -402,6 +454,7 @@ class Scene:
     springs: list[dict[str, Any]]
     run: dict[str, float]
     description: str | None = None
+    scanners: list[dict[str, Any]] = field(default_factory=list)  # for the ROS node; the engine ignores them
     source: str = field(default="<scene>", compare=False)
     _lines: dict[Path_, int] = field(default_factory=dict, repr=False, compare=False)
 
@@ -423,6 +476,8 @@ class Scene:
             out["walls"] = dict(self.walls)
         out["bodies"] = [strip(b) for b in self.bodies]
         out["springs"] = [strip(s) for s in self.springs]
+        if self.scanners:
+            out["scanners"] = [dict(s) for s in self.scanners]
         out["run"] = dict(self.run)
         return copy.deepcopy(out)
 
@@ -501,6 +556,16 @@ def _from_data(data: Any, parsed: _Parsed, validate: bool) -> Scene:
             for key in ("body_a", "body_b"):
                 if s[key] is not None and s[key] not in names:
                     parsed.error(("springs", i, key), f"no body named {s[key]!r}")
+        scanner_names: set[str] = set()
+        for i, sc in enumerate(top["scanners"]):
+            if sc["body"] not in names:
+                parsed.error(("scanners", i, "body"), f"no body named {sc['body']!r}")
+            if sc["name"] in scanner_names or sc["name"] in names:
+                parsed.error(("scanners", i, "name"), f"{sc['name']!r} is taken (by a scanner or a body: "
+                                                      "the frames of both are named after them)")
+            scanner_names.add(sc["name"])
+            for key, why in scanner_problems(sc):
+                parsed.error(("scanners", i, key), why)
         if top["run"]["dt"] <= 0 or top["run"]["dt"] > 1:
             parsed.error(("run", "dt"), f"must be in (0, 1] s, got {top['run']['dt']}")
         if top["run"]["duration"] < 0:
@@ -508,7 +573,8 @@ def _from_data(data: Any, parsed: _Parsed, validate: bool) -> Scene:
     if parsed.errors:
         raise SceneError(parsed.source, parsed.errors[:20])
     scene = Scene(world=top["world"], walls=top["walls"], bodies=top["bodies"], springs=top["springs"],
-                  run=top["run"], description=top["description"], source=parsed.source, _lines=parsed.lines)
+                  run=top["run"], description=top["description"], scanners=top["scanners"], source=parsed.source,
+                  _lines=parsed.lines)
     if validate:
         scene.build()  # range rules live in C: a trial build reports them against the scene's lines
     return scene

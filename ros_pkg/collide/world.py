@@ -18,7 +18,7 @@ from .body import Body, BodyRef, Spring, Thruster, _Record, _vec
 from . import force as _force
 from . import query as _query
 from .force import ForceFn, PotentialFn
-from .query import BodyDistance, RayHit
+from .query import BodyDistance, RayHit, RayHits
 
 __all__ = ["World", "Body", "Thruster", "Spring", "Energy", "CollideError", "CONTACT_DTYPE",
            "COLLISION", "RESTING", "EVENT_DTYPE", "IMPACT_EVENT", "IMPACT_CONTACT", "WALL_NAMES"]
@@ -504,6 +504,12 @@ class World:
                      skip: BodyRef | None = None) -> list[RayHit]:
         """Every body the segment meets, one RayHit each, sorted by fraction."""
         return _query.ray_cast_all(self, start, end, skip_static, skip)
+
+    def ray_cast_batch(self, starts: Any, ends: Any, skip_static: bool = False,
+                       skip: BodyRef | None = None) -> RayHits:
+        """The first hit of each segment starts[i] -> ends[i] ((n, 2) arrays; one (2,) start for all),
+        one C call for all (RayHits of arrays by ray)."""
+        return _query.ray_cast_batch(self, starts, ends, skip_static, skip)
 
     def body_distance(self, a: BodyRef, b: BodyRef) -> BodyDistance:
         """Distance of two bodies (< 0: minus the penetration depth), normal from a to b, closest points."""

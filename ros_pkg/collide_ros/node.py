@@ -29,6 +29,7 @@ from collide_ros.sim.loop import CATCH_UP_LIMIT, Loop
 from collide_ros.sim.parameters import Parameters
 from collide_ros.sim.publishing import MAX_CONTACTS_PER_MESSAGE, Publishing
 from collide_ros.sim.publishing import concat_rows as _concat_rows
+from collide_ros.sim.scanners import Scanners
 from collide_ros.sim.services import MAX_STEPS_PER_CALL, Services
 from collide_ros.sim.spawning import Spawning
 from collide_ros.sim.stepping import SPLIT_DEPTH, SPLIT_MAX_SOLVER_WORK_PER_BODY, SPLIT_MAX_WORK, Stepping
@@ -39,8 +40,8 @@ __all__ = ["SimNode", "main", "APPLIED", "CATCH_UP_LIMIT", "MAX_CMD_SPEED", "MAX
            "_concat_rows"]
 
 
-class SimNode(Loop, Stepping, Forces, Commands, Publishing, Diagnostics, Services, Spawning, Parameters, Topology,
-              Guards, Node):
+class SimNode(Loop, Stepping, Forces, Commands, Publishing, Scanners, Diagnostics, Services, Spawning, Parameters,
+              Topology, Guards, Node):
     """The ``sim`` node. Construct after rclpy.init(); call run() to simulate until shutdown."""
 
     #: every accepted command is republished on applied/<topic> (docs/contracts.md, bit-exact replay)
@@ -54,6 +55,7 @@ class SimNode(Loop, Stepping, Forces, Commands, Publishing, Diagnostics, Service
         self._paused = bool(self._p["start_paused"])
         self._build_world()  # raises on a bad scene file: the node cannot start without a world
         self._init_publishing()
+        self._init_scanners()
         self._init_diagnostics()
         self._init_forces()
         self._init_commands()

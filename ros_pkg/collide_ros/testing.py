@@ -91,9 +91,11 @@ def diag_values(msg: Any, name: str = "/sim") -> dict[str, str] | None:
 
 def diag_counts(values: dict[str, str]) -> dict[str, int]:
     """The message counts among diagnostics values (docs/ros_interface.md, /diagnostics), with
-    rejected_commands (every rejection, also of a failed physics step), dropped_contacts and split_steps."""
+    rejected_commands (every rejection, also of a failed physics step), dropped_contacts, dropped_impacts
+    and split_steps."""
     return {k: int(v) for k, v in values.items()
-            if k.startswith(COUNT_PREFIXES) or k in ("rejected_commands", "dropped_contacts", "split_steps")}
+            if k.startswith(COUNT_PREFIXES)
+            or k in ("rejected_commands", "dropped_contacts", "dropped_impacts", "split_steps")}
 
 
 def _param_value(v: Any) -> ParameterValue:

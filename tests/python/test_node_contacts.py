@@ -6,7 +6,7 @@ One in-process node (no executor, no subscribers) runs the node bench's pile: 20
 with friction (bench/node_bench.py, pile_scene). Its publishes are recorded with the rows
 ``_take_contacts`` handed over: an empty message first (``~/reset`` publishes before any step),
 then impacts and resting contacts, messages held at the cap of 1000 while the pile forms, and,
-after a body with kept impacts is killed, names of an id the node no longer knows. Every message
+after a body with unread impacts is killed, names of an id the node no longer knows. Every message
 must decode field by field to the object path's message and match its bytes. The rows themselves
 (``_take_contacts``, joined as opaque records) are checked against np.concatenate on their own.
 """
@@ -35,7 +35,7 @@ from collide_ros.node import MAX_CONTACTS_PER_MESSAGE, SimNode, _concat_rows
 
 ROOT = Path(__file__).resolve().parents[2]
 STEPS = 2000      # the pile holds 1000 contacts per message from ~1.5 s on
-KILL_AT = 1700    # step after which a body with kept impacts is killed
+KILL_AT = 1700    # step after which a body with unread impacts is killed
 FIELDS = ("body_a", "body_b", "point", "normal", "gap", "normal_velocity", "impulse", "tangent_impulse",
           "force", "kind")
 
@@ -98,11 +98,15 @@ def _record(node: SimNode, log: list[Published]) -> None:
     node._pub_contacts.pub.publish = publish_kept
 
 
-def _kill_a_body_with_kept_impacts(node: SimNode) -> int:
-    """Kill a dynamic body that a kept (not yet published) impact names; returns its id."""
-    ids = np.concatenate([p["body_a"] for p in node._pending] + [p["body_b"] for p in node._pending])
+def _kill_a_body_with_unread_impacts(node: SimNode) -> int:
+    """Kill a dynamic body that the last step's impacts name, after a step with no publish: those
+    impacts are unread in the world's event stream (the next contacts message carries them); returns
+    its id."""
+    c = node.world.contacts
+    hits = c[c["kind"] == collide.COLLISION]
     dynamic = {int(node._ids[r]) for r in node._dyn_rows}
-    victim = next(int(i) for i in ids if int(i) in dynamic and node._name_of_id[int(i)] != "block1")
+    victim = next(int(i) for i in np.concatenate([hits["body_a"], hits["body_b"]])
+                  if int(i) in dynamic and node._name_of_id[int(i)] != "block1")
     resp = node._srv_kill(Kill.Request(name=node._name_of_id[victim]), Kill.Response())
     assert resp.success, resp.message
     return victim
@@ -120,10 +124,13 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[list[Publish
         _record(node, log)
         node.reset()  # publishes the state of the fresh world, before any step: no contacts
         killed = -1
+        every = round(1.0 / (node.get_parameter("state_rate").value * node.get_parameter("time_step").value))
         for k in range(STEPS):
             assert node.step_once(), node.last_rejection
-            if k + 1 >= KILL_AT and killed < 0 and node._pending:
-                killed = _kill_a_body_with_kept_impacts(node)
+            c = node.world.contacts
+            if (k + 1 >= KILL_AT and killed < 0 and (k + 1) % every
+                    and np.any(c["kind"] == collide.COLLISION) and node.world.pending_events):
+                killed = _kill_a_body_with_unread_impacts(node)
         yield log, killed
     finally:
         node.destroy_node()
@@ -169,7 +176,7 @@ def test_cdr_contacts_equal_the_object_path(run: tuple[list[Published], int]) ->
 
 
 def test_concat_rows_equals_numpy_concatenate() -> None:
-    # _take_contacts joins the kept impacts and the resting contacts as opaque records (C's padded
+    # _take_contacts joins the unread impacts and the resting contacts as opaque records (C's padded
     # lc_contact layout kept); field for field the same rows as np.concatenate, also across dtypes
     rng = np.random.default_rng(3)
     parts = []

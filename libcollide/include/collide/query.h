@@ -69,6 +69,13 @@ LC_API lc_status lc_world_ray_cast(const lc_world *world, lc_vec2 start, lc_vec2
  * when capacity is 0); *out_count gets the number of bodies hit, which may exceed capacity. */
 LC_API lc_status lc_world_ray_cast_all(const lc_world *world, lc_vec2 start, lc_vec2 end, const lc_query_filter *filter,
                                        lc_ray_hit *out, int capacity, int *out_count);
+/* The first hit of each of `count` segments (count >= 0), ray i from starts[i] to ends[i], all with one
+ * filter: out_found[i] = 1 and the hit in out_hits[i] as lc_world_ray_cast gives it (bit for bit), or
+ * out_found[i] = 0 and out_hits[i] untouched. Every ray is checked before any is cast: a bad one fails
+ * the call (the message names its index) and nothing is written. One call for a laser scan: the bodies
+ * near the rays are found once for all of them. */
+LC_API lc_status lc_world_ray_cast_batch(const lc_world *world, const lc_vec2 *starts, const lc_vec2 *ends, int count,
+                                         const lc_query_filter *filter, lc_ray_hit *out_hits, int *out_found);
 /* 1 in *out_overlap when bodies a and b (a != b) share at least one point (touching counts), else 0. */
 LC_API lc_status lc_body_overlap(const lc_world *world, lc_body_id a, lc_body_id b, int *out_overlap);
 /* Distance, normal and closest points of bodies a and b (a != b); see lc_distance_result. */

@@ -57,7 +57,8 @@ class Diagnostics:
             "dynamic_bodies": str(len(self._dyn_names)), "contacts": str(len(self.world.contacts)),
             "sim_time": f"{sim:.6f}", "paused": str(self._paused).lower(),
             "rejected_commands": str(self.rejected), "last_rejection": self.last_rejection,
-            "dropped_contacts": str(self.dropped_contacts), "split_steps": str(self.split_steps),
+            "dropped_contacts": str(self.dropped_contacts),
+            "dropped_impacts": str(self.dropped_impacts), "split_steps": str(self.split_steps),
         }
         vals.update(self._count_values())
         st.values = [KeyValue(key=k, value=v) for k, v in vals.items()]

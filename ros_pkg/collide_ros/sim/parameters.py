@@ -108,6 +108,8 @@ class Parameters:
                 self._inertias = np.array(self.world.inertias)
         elif name in ("time_step", "state_rate", "tf_rate", "marker_rate", "clock_rate"):
             self._periods()
+            if name == "time_step":
+                self._make_scanners()  # their periods in steps
             self._schedule_dirty = True
         elif name == "real_time_factor":
             self._schedule_dirty = True

@@ -1,6 +1,8 @@
 """What the node publishes at rates counted in sim-time steps: bodies/poses, bodies/states, contacts and
-energy (state_rate), /tf, markers and /clock. The bulk messages are written as CDR bytes with numpy
-(cdr.py, markers.py); the impacts of every step are kept until the next contacts message."""
+energy (state_rate), /tf, markers and /clock; the laser scans are scanners.py's. The bulk messages are
+written as CDR bytes with numpy (cdr.py, markers.py); the contacts message takes the impacts since the
+last one from the world's impact event stream, which keeps them across steps
+(docs/events_and_snapshots.md)."""
 from __future__ import annotations
 
 from typing import Any
@@ -17,13 +19,30 @@ import collide
 
 from collide_ros import cdr, markers, qos
 
-# Contacts per contacts message (impacts since the last one first, then resting contacts); more
-# are dropped and counted (dropped_contacts). A reliable writer's history keeps every slot's
+# Contacts per contacts message (impacts since the last one first, then resting contacts). Impacts
+# past it stay in the world's event stream for the next message; resting contacts past it are dropped
+# and counted (dropped_contacts). A reliable writer's history keeps every slot's
 # largest message (Fast DDS reallocates a slot's buffer upwards, never down), so the node's memory
 # grows towards state_qos_depth x the largest contacts message: 1000 contacts (~74 kB) x 100 =
 # ~7 MB. Uncapped, the soak saw 100 000 impacts (7.4 MB) in one message and the RSS grew by 94 MiB
 # in an hour (docs/hardening.md, "Soak").
 MAX_CONTACTS_PER_MESSAGE = 1000
+
+#: the fields an impact event and a collision contact share under one name
+_SHARED_FIELDS = ("body_a", "body_b", "point", "normal", "gap", "tangent_impulse", "time")
+
+
+def impact_rows(events: np.ndarray) -> np.ndarray:
+    """Impact events (collide.EVENT_DTYPE) as the contacts view's rows (collide.CONTACT_DTYPE, kind
+    COLLISION): the numbers the step's collision contact carries, normal_velocity being minus the
+    approach speed (a sign flip, exact) and force 0."""
+    rows = np.zeros(len(events), dtype=collide.CONTACT_DTYPE)
+    for f in _SHARED_FIELDS:
+        rows[f] = events[f]
+    rows["normal_velocity"] = -events["approach_speed"]
+    rows["impulse"] = events["normal_impulse"]
+    rows["kind"] = collide.COLLISION
+    return rows
 
 
 def hex_color(value: Any, fallback: markers.Color) -> markers.Color:
@@ -50,8 +69,8 @@ def concat_rows(parts: list[np.ndarray]) -> np.ndarray:
 class Publishing:
     """Owns the publishers of the state topics (``_pub_poses``, ``_pub_states``, ``_pub_contacts``,
     ``_pub_energy``, ``_pub_clock`` (None with publish_clock false), ``_pub_tf``, ``_pub_markers``), their
-    CDR writers (``_cdr_*``), the publish periods in steps (``_every_*``) and the impacts kept for the next
-    contacts message (``_pending``, ``_pending_count``, ``dropped_contacts``)."""
+    CDR writers (``_cdr_*``), the publish periods in steps (``_every_*``) and the counts of what the
+    contacts messages left out (``dropped_contacts``, ``dropped_impacts``)."""
 
     def _init_publishing(self) -> None:
         state_qos = qos.state(int(self._p["state_qos_depth"]))
@@ -63,9 +82,8 @@ class Publishing:
         self._pub_clock = self._publisher(Clock, "/clock", qos.CLOCK) if self._p["publish_clock"] else None
         self._pub_tf = self._publisher(TFMessage, "/tf", qos.TF)
         self._pub_markers = self._publisher(MarkerArray, "markers", qos.MARKERS)
-        self._pending: list[np.ndarray] = []
-        self._pending_count = 0
-        self.dropped_contacts = 0  # beyond MAX_CONTACTS_PER_MESSAGE, since the start
+        self.dropped_contacts = 0  # resting contacts beyond MAX_CONTACTS_PER_MESSAGE, since the start
+        self.dropped_impacts = 0   # impacts the event stream let go (event_capacity unread), since the start
 
     def _periods(self) -> None:
         dt = float(self._p["time_step"])
@@ -106,6 +124,8 @@ class Publishing:
             self._publish_tf()
         if self._every_marker and s % self._every_marker == 0:
             self._publish_markers()
+        if self._scanners:
+            self._publish_scans(s)
 
     def _stamp(self) -> tuple[int, int]:
         return cdr.split_time(self.sim_time)
@@ -129,32 +149,24 @@ class Publishing:
         self._pub_energy.publish(em)
         self._pub_contacts.publish(self._cdr_contacts.encode(sec, ns, self._take_contacts()))
 
-    def _collect_collisions(self) -> None:
-        """Keep the impacts of every step until the next contacts publish (they last one step)."""
-        c = self.world.contacts
-        if len(c):
-            hits = c[c["kind"] == collide.COLLISION]
-            room = MAX_CONTACTS_PER_MESSAGE - self._pending_count
-            if len(hits) > room:
-                self.dropped_contacts += len(hits) - room
-                hits = hits[:room]
-            if len(hits):
-                self._pending.append(hits.copy())
-                self._pending_count += len(hits)
-
     def _take_contacts(self) -> np.ndarray:
-        """Impacts since the last publish, then the resting contacts of the current step (at most
-        MAX_CONTACTS_PER_MESSAGE in all)."""
+        """The impacts since the last publish (the event stream, oldest first, at most
+        MAX_CONTACTS_PER_MESSAGE: the rest wait for the next message), then the resting contacts of
+        the current step as room allows."""
+        # sized to what is unread (a buffer of the cap would be zeroed at every publish), and at least
+        # 1 so that the read reports the drops even when nothing is kept (event_capacity 0)
+        events, dropped = self.world.read_events(min(max(self.world.pending_events, 1), MAX_CONTACTS_PER_MESSAGE))
+        self.dropped_impacts += dropped
+        impacts = impact_rows(events)
         c = self.world.contacts
         resting = c[c["kind"] != collide.COLLISION]
-        room = MAX_CONTACTS_PER_MESSAGE - self._pending_count
+        room = MAX_CONTACTS_PER_MESSAGE - len(impacts)
         if len(resting) > room:
             self.dropped_contacts += len(resting) - room
             resting = resting[:room]
-        parts = [*self._pending, resting]
-        self._pending = []
-        self._pending_count = 0
-        return concat_rows(parts) if len(parts) > 1 else resting.copy()
+        if not len(impacts):
+            return resting.copy()
+        return concat_rows([impacts, resting]) if len(resting) else impacts
 
     def _publish_tf(self) -> None:
         sec, ns = self._stamp()

@@ -33,7 +33,6 @@ class Services:
         self._thrusters.clear()
         self._cmd_vel = None
         self._ext_bodies.clear()
-        self._pending, self._pending_count = [], 0
         offset = self.sim_time  # the clock keeps running forward across a reset
         self._build_world()
         self._time_offset = offset

@@ -1,6 +1,6 @@
 """One physics step of the node: the commands' forces applied, the world stepped (a step C undoes taken in
-parts instead, within limits: the split policy below), the step's impacts kept, the step's time measured,
-and the publishing that is due after it."""
+parts instead, within limits: the split policy below), the step's time measured, and the publishing that
+is due after it. The world's event stream keeps the impacts of every step and part taken."""
 from __future__ import annotations
 
 import time
@@ -39,14 +39,13 @@ class Stepping:
         self.failing_since: float | None = None
 
     def _step_in_parts(self, dt: float) -> None:
-        """world.step(dt) and its impacts kept; a step C undoes is taken as halves instead (recursively,
+        """world.step(dt); a step C undoes is taken as halves instead (recursively,
         SPLIT_DEPTH levels), unless its work counters say it was costly (SPLIT_MAX_WORK). Raises C's
         error if a part of dt / 2**SPLIT_DEPTH or a costly part fails; the parts before it stay taken
         (their time too: the sim clock then leaves the time_step grid)."""
         self._split_tried = False
         try:
             self.world.step(dt)
-            self._collect_collisions()
             return
         except CollideError as exc:
             why = str(exc)
@@ -70,8 +69,7 @@ class Stepping:
         n = 0
         for _ in range(2):
             try:
-                self.world.step(dt / 2)
-                self._collect_collisions()  # each part's impacts: the world keeps only the last part's
+                self.world.step(dt / 2)  # each part's impacts enter the event stream
                 n += 1
             except CollideError:
                 if depth >= SPLIT_DEPTH or not self._worth_splitting():

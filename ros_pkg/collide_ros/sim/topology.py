@@ -7,6 +7,8 @@ import numpy as np
 
 import collide
 
+from collide_ros.sim.scanners import ScannerSpec
+
 
 #: parameters that change the world in place (applied at once)
 WORLD_SETTINGS = ("gravity", "damping", "elasticity", "green_mass")
@@ -25,7 +27,7 @@ def scene_values(scene: collide.Scene, world: collide.World) -> dict[str, float]
 
 class Topology:
     """Owns ``world``, ``_time_offset`` (sim time before the last reset), ``_colors`` (scene colours by
-    body) and the body-set tables: ``_names``, ``_ids``, ``_static``, ``_dyn_rows``, ``_dyn_names``,
+    body), ``_scanner_specs`` (the scene's laser scanners) and the body-set tables: ``_names``, ``_ids``, ``_static``, ``_dyn_rows``, ``_dyn_names``,
     ``_row_of``, ``_name_of_id``, ``_bodies``, ``_masses``, ``_inertias``."""
 
     world: collide.World
@@ -45,6 +47,7 @@ class Topology:
         scene = self._scene()
         world = scene.build()
         self._colors = {b["name"]: b.get("color") for b in scene.bodies}
+        self._scanner_specs = [ScannerSpec.from_scene(sc) for sc in scene.scanners]
         if self._p["scene_file"]:
             # A scene file brings its own settings; a parameter applies only where it differs from the file.
             for key in WORLD_SETTINGS:
@@ -79,6 +82,7 @@ class Topology:
         self._masses = np.array(w.masses)
         self._inertias = np.array(w.inertias)
         self._make_writers()
+        self._make_scanners()
         self._make_thrust_topics()
         self._forget_gone_bodies()
         self._publish_markers(reset=deleteall)
