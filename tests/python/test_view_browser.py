@@ -319,7 +319,9 @@ def test_bad_websocket_input_is_refused(stack: Stack) -> None:
     out = stack.page.evaluate("""async () => {
       const ws = new WebSocket(location.origin.replace('http', 'ws') + '/ws');
       const got = [];
-      ws.onmessage = (e) => { const m = JSON.parse(e.data); if (m.type === 'refused') got.push(m.reason); };
+      ws.onmessage = (e) => {  // text: JSON replies and refusals; binary: state frames
+        if (typeof e.data !== 'string') return;
+        const m = JSON.parse(e.data); if (m.type === 'refused') got.push(m.reason); };
       await new Promise((ok) => { ws.onopen = ok; });
       for (const s of ['{', '[1,2]', '{"type":"spring","body":"block1","point":[0,0],"target":[NaN,0]}',
                        '{"type":"spring","body":"block1","point":[0,0],"target":[1e300,0]}',

@@ -4,8 +4,9 @@
                                [--ros-args -r __ns:=/robot1]
 
 HTTP and the WebSocket share one port (websockets' ``process_request`` serves the page). Each page
-gets the latest state at ``--rate`` Hz: a frame is built from the newest data when it is due and
-sent before the next one is built, so a slow page gets fewer frames, never a backlog. ``--foxglove``
+gets the latest state at ``--rate`` Hz as a binary frame (frames.py): a frame is built from the newest
+data when it is due and sent before the next one is built, so a slow page gets fewer frames, never a
+backlog. ``--foxglove``
 also serves the scene over the Foxglove WebSocket protocol (foxglove_bridge.py) on the same host.
 """
 from __future__ import annotations
@@ -29,7 +30,7 @@ from websockets.exceptions import ConnectionClosed
 from websockets.http11 import Request, Response
 
 from collide_ros.teleop import KEYMAP
-from collide_ros.view import protocol
+from collide_ros.view import frames, protocol
 from collide_ros.view.bridge import ViewBridge, spin_in_thread
 
 PAGE = Path(__file__).with_name("page.html")
@@ -75,9 +76,10 @@ class ViewServer:
             pending[0] -= 1
         loop = asyncio.get_running_loop()
 
-        async def send(obj: dict[str, Any]) -> None:
+        async def send(obj: dict[str, Any] | bytes) -> None:
+            """A JSON text message, or bytes as one binary message (a state frame)."""
             async with send_lock:
-                await ws.send(json.dumps(obj, allow_nan=False, default=float))
+                await ws.send(obj if isinstance(obj, bytes) else json.dumps(obj, allow_nan=False, default=float))
 
         def reply_soon(req_id: int | None, kind: str) -> Any:
             def reply(ok: bool, message: str) -> None:  # on the executor thread
@@ -145,7 +147,7 @@ class ViewServer:
                     await send(shapes)
                 if new_seq != seq or t0 - last >= HEARTBEAT or state["version"] != version:
                     seq, last = new_seq, t0
-                    await send(state)
+                    await send(frames.encode_state(state))
                 await asyncio.sleep(max(0.0, self.period - (time.monotonic() - t0)))
         except (ConnectionClosed, asyncio.CancelledError):
             pass
