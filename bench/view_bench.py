@@ -17,9 +17,13 @@ Measured, in this order:
 - the view process's CPU share (utime + stime from /proc over --seconds), first with the page alone
   (the Foxglove server idle: nothing subscribed), then with a Foxglove client subscribed to /scene,
   /tf and /energy as well, reading every message;
-- the page: animation frames per second (a requestAnimationFrame counter beside the page's own
-  drawing, which runs in the same frames) and state frames per second received from the view, over
-  --seconds.
+- the page, over --seconds: animation frames per second (a requestAnimationFrame counter beside the
+  page's own drawing), the page's draws of the scene per second (it draws in every animation frame)
+  and the mean time one draw takes (performance.now() around it: the script's work, not the
+  raster), state frames per second received from the view, and the sim seconds those frames advance per wall
+  second (the node's real-time factor: the node publishes bodies/states at 100 Hz of sim time, so
+  at most 100 x that many new states a second exist to be sent, and the view sends at most --rate,
+  30); then how many of the page's shapes the view named as the node's dynamic bodies.
 
 Not run by the tests (timings). Uses ROS_DOMAIN_ID from the environment, or picks a free one in the
 bench range 75-79. Prints a markdown table.
@@ -101,15 +105,17 @@ def cpu_share(pid: int, seconds: float) -> float:
     return (node_bench.cpu_seconds(pid) - c0) / (time.monotonic() - t0)
 
 
-def page_rates(page: Any, seconds: float) -> tuple[float, float]:
-    """(animation frames per second, state frames received per second) over ``seconds``."""
+def page_rates(page: Any, seconds: float) -> tuple[float, float, float, float, float]:
+    """(animation frames per second, the page's draws per second, its mean milliseconds per draw,
+    state frames received per second, sim seconds per wall second in those frames) over ``seconds``."""
     got = page.evaluate("""async (ms) => {
-      const f0 = window.__view.frames, t0 = performance.now(); let n = 0;
+      const V = window.__view, f0 = V.frames, d0 = V.draws, m0 = V.drawMs, s0 = V.t, t0 = performance.now(); let n = 0;
       await new Promise((ok) => { const tick = () => { n++; if (performance.now() - t0 < ms) requestAnimationFrame(tick);
                                                          else ok(); }; requestAnimationFrame(tick); });
-      const dt = (performance.now() - t0) / 1000;
-      return [n / dt, (window.__view.frames - f0) / dt]; }""", seconds * 1000.0)
-    return float(got[0]), float(got[1])
+      const dt = (performance.now() - t0) / 1000, draws = V.draws - d0;
+      return [n / dt, draws / dt, (V.drawMs - m0) / Math.max(1, draws), (V.frames - f0) / dt, (V.t - s0) / dt]; }""",
+                        seconds * 1000.0)
+    return float(got[0]), float(got[1]), float(got[2]), float(got[3]), float(got[4])
 
 
 def spring_latency(page: Any, echoes: list[tuple[float, float]], lock: threading.Lock, trials: int) -> list[float]:
@@ -190,7 +196,8 @@ def run_case(label: str, trials: int, seconds: float) -> dict[str, Any]:
                 res["latency_view"] = spring_latency(page, sent, lock, trials)
                 res["lost"] = 2 * trials - len(res["latency"]) - len(res["latency_view"])
             res["cpu_page"] = cpu_share(view.proc.pid, seconds)
-            res["fps"], res["frames"] = page_rates(page, seconds)
+            res["fps"], res["draws"], res["draw_ms"], res["frames"], res["rtf"] = page_rates(page, seconds)
+            res["named"] = page.evaluate("window.__view.shapes.filter((b) => b.name).length")
             assert view.foxglove_port
             fox = FoxgloveReader(view.foxglove_port)
             m0, b0, t0 = fox.messages, fox.bytes, time.monotonic()
@@ -244,16 +251,16 @@ def main() -> int:
             lock.release()
     print(f"load average at the end: {' '.join(f'{x:.1f}' for x in os.getloadavg())}")
     print("\n| bodies | pointer -> node's echo p50 / p90 (ms) | pointer -> view's spring p50 / p90 (ms) "
-          "| view CPU, page | view CPU, page + Foxglove client | page fps (drawing) | state frames/s on the page "
-          "| Foxglove messages/s (MB/s) |")
-    print("|---|---|---|---|---|---|---|---|")
+          "| view CPU, page | view CPU, page + Foxglove client | page fps (animation frames) | page draws/s (ms each) "
+          "| state frames/s on the page | sim s per wall s | bodies named | Foxglove messages/s (MB/s) |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|")
 
     def ms(lat: list[float] | None) -> str:
         return f"{1e3 * statistics.median(lat):.0f} / {1e3 * percentile(lat, 0.9):.0f}" if lat else "-"
     for r in rows:
         print(f"| {r['case']} | {ms(r.get('latency'))} | {ms(r.get('latency_view'))} | {100 * r['cpu_page']:.0f} % "
-              f"| {100 * r['cpu_fox']:.0f} % | {r['fps']:.0f} | {r['frames']:.0f} "
-              f"| {r['fox_msgs']:.0f} ({r['fox_mbps']:.2f}) |")
+              f"| {100 * r['cpu_fox']:.0f} % | {r['fps']:.0f} | {r['draws']:.0f} ({r['draw_ms']:.1f}) | {r['frames']:.0f} | {r['rtf']:.2f} "
+              f"| {r['named']} | {r['fox_msgs']:.0f} ({r['fox_mbps']:.2f}) |")
     return 0
 
 
