@@ -18,12 +18,14 @@ Measured, in this order:
   (the Foxglove server idle: nothing subscribed), then with a Foxglove client subscribed to /scene,
   /tf and /energy as well, reading every message;
 - the page, over --seconds: animation frames per second (a requestAnimationFrame counter beside the
-  page's own drawing), the page's draws of the scene per second (it draws in every animation frame)
-  and the mean time one draw takes (performance.now() around it: the script's work, not the
+  page's own), the page's draws of the scene per second (it draws when something changed: a new
+  state) and the mean time one draw takes (performance.now() around it: the script's work, not the
   raster), state frames per second received from the view, and the sim seconds those frames advance per wall
   second (the node's real-time factor: the node publishes bodies/states at 100 Hz of sim time, so
   at most 100 x that many new states a second exist to be sent, and the view sends at most --rate,
-  30); then how many of the page's shapes the view named as the node's dynamic bodies.
+  30); then, over another --seconds, the animation frames per second and the time per draw with the
+  page drawing in every frame (``__view.drawEveryFrame``): whether it keeps 60 fps drawing; then how
+  many of the page's shapes the view named as the node's dynamic bodies.
 
 Not run by the tests (timings). Uses ROS_DOMAIN_ID from the environment, or picks a free one in the
 bench range 75-79. Prints a markdown table.
@@ -105,9 +107,11 @@ def cpu_share(pid: int, seconds: float) -> float:
     return (node_bench.cpu_seconds(pid) - c0) / (time.monotonic() - t0)
 
 
-def page_rates(page: Any, seconds: float) -> tuple[float, float, float, float, float]:
+def page_rates(page: Any, seconds: float, every_frame: bool = False) -> tuple[float, float, float, float, float]:
     """(animation frames per second, the page's draws per second, its mean milliseconds per draw,
-    state frames received per second, sim seconds per wall second in those frames) over ``seconds``."""
+    state frames received per second, sim seconds per wall second in those frames) over ``seconds``;
+    ``every_frame``: the page draws in every animation frame, not only when something changed."""
+    page.evaluate(f"window.__view.drawEveryFrame = {str(every_frame).lower()}")
     got = page.evaluate("""async (ms) => {
       const V = window.__view, f0 = V.frames, d0 = V.draws, m0 = V.drawMs, s0 = V.t, t0 = performance.now(); let n = 0;
       await new Promise((ok) => { const tick = () => { n++; if (performance.now() - t0 < ms) requestAnimationFrame(tick);
@@ -197,6 +201,8 @@ def run_case(label: str, trials: int, seconds: float) -> dict[str, Any]:
                 res["lost"] = 2 * trials - len(res["latency"]) - len(res["latency_view"])
             res["cpu_page"] = cpu_share(view.proc.pid, seconds)
             res["fps"], res["draws"], res["draw_ms"], res["frames"], res["rtf"] = page_rates(page, seconds)
+            res["fps_all"], _, res["draw_ms_all"], _, _ = page_rates(page, seconds, every_frame=True)
+            page_rates(page, 0.0)  # back to drawing on change
             res["named"] = page.evaluate("window.__view.shapes.filter((b) => b.name).length")
             assert view.foxglove_port
             fox = FoxgloveReader(view.foxglove_port)
@@ -251,15 +257,15 @@ def main() -> int:
             lock.release()
     print(f"load average at the end: {' '.join(f'{x:.1f}' for x in os.getloadavg())}")
     print("\n| bodies | pointer -> node's echo p50 / p90 (ms) | pointer -> view's spring p50 / p90 (ms) "
-          "| view CPU, page | view CPU, page + Foxglove client | page fps (animation frames) | page draws/s (ms each) "
+          "| view CPU, page | view CPU, page + Foxglove client | page fps (animation frames) | page draws/s (ms each) | page fps drawing every frame (ms each) "
           "| state frames/s on the page | sim s per wall s | bodies named | Foxglove messages/s (MB/s) |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
 
     def ms(lat: list[float] | None) -> str:
         return f"{1e3 * statistics.median(lat):.0f} / {1e3 * percentile(lat, 0.9):.0f}" if lat else "-"
     for r in rows:
         print(f"| {r['case']} | {ms(r.get('latency'))} | {ms(r.get('latency_view'))} | {100 * r['cpu_page']:.0f} % "
-              f"| {100 * r['cpu_fox']:.0f} % | {r['fps']:.0f} | {r['draws']:.0f} ({r['draw_ms']:.1f}) | {r['frames']:.0f} | {r['rtf']:.2f} "
+              f"| {100 * r['cpu_fox']:.0f} % | {r['fps']:.0f} | {r['draws']:.0f} ({r['draw_ms']:.1f}) | {r['fps_all']:.0f} ({r['draw_ms_all']:.1f}) | {r['frames']:.0f} | {r['rtf']:.2f} "
               f"| {r['named']} | {r['fox_msgs']:.0f} ({r['fox_mbps']:.2f}) |")
     return 0
 
