@@ -1,7 +1,7 @@
 """Benchmark of the live view (python -m collide_ros.view): pointer -> spring latency, the view's CPU
 at 6 and 1000 bodies, the page's drawing rate in headless Chromium.
 
-    source scripts/env.sh && nice python bench/view_bench.py [--bodies 6 1000] [--trials 40] [--seconds 8]
+    source scripts/env.sh && nice python bench/view_bench.py [--bodies 6 1000] [--trials 40] [--seconds 8] [--repeat 1]
 
 Per case a sim node runs with bench/node_bench.py's parameters and scene (6: the default scene with
 blocks:=6; 1000: its generated scene of 1000 moving boxes), a view beside it with ``--foxglove``
@@ -225,6 +225,17 @@ def run_case(label: str, trials: int, seconds: float) -> dict[str, Any]:
     return res
 
 
+def median_of(runs: list[dict[str, Any]]) -> dict[str, Any]:
+    """One row from the runs of a case: the median of each figure, the latency samples pooled."""
+    out: dict[str, Any] = {"case": runs[0]["case"]}
+    for key, value in runs[0].items():
+        if key.startswith("latency"):
+            out[key] = [x for r in runs for x in r[key]]
+        elif isinstance(value, (int, float)):
+            out[key] = statistics.median(r[key] for r in runs)
+    return out
+
+
 def _spin(ex: Any, ctx: Any) -> None:
     while ctx.ok():
         try:
@@ -238,6 +249,9 @@ def main() -> int:
     p.add_argument("--bodies", nargs="+", default=["6", "1000"], help="cases (node_bench's: 6, 1000, ...)")
     p.add_argument("--trials", type=int, default=40, help="pointer moves for the latency (6 bodies)")
     p.add_argument("--seconds", type=float, default=8.0, help="wall seconds of each CPU and frame-rate window")
+    p.add_argument("--repeat", type=int, default=1,
+                   help="runs of each case (each a fresh node, view and browser); the table gives the median "
+                        "of every figure over the runs, the latencies pooled")
     a = p.parse_args()
     if not os.access(CHROMIUM, os.X_OK):
         print(f"view_bench: {CHROMIUM} is missing; run scripts/setup", file=sys.stderr)
@@ -249,13 +263,18 @@ def main() -> int:
     rows = []
     try:
         for label in a.bodies:
-            r = run_case(label, a.trials if int(label) <= 6 else 0, a.seconds)
-            rows.append(r)
-            print(f"  {label}: {json.dumps({k: v for k, v in r.items() if not k.startswith('latency')})}", flush=True)
+            runs = []
+            for _ in range(max(1, a.repeat)):
+                r = run_case(label, a.trials if int(label) <= 6 else 0, a.seconds)
+                runs.append(r)
+                print(f"  {label}: {json.dumps({k: v for k, v in r.items() if not k.startswith('latency')})}",
+                      flush=True)
+            rows.append(median_of(runs))
     finally:
         if lock is not None:
             lock.release()
-    print(f"load average at the end: {' '.join(f'{x:.1f}' for x in os.getloadavg())}")
+    print(f"load average at the end: {' '.join(f'{x:.1f}' for x in os.getloadavg())}; "
+          f"{max(1, a.repeat)} run(s) per case")
     print("\n| bodies | pointer -> node's echo p50 / p90 (ms) | pointer -> view's spring p50 / p90 (ms) "
           "| view CPU, page | view CPU, page + Foxglove client | page fps (animation frames) | page draws/s (ms each) | page fps drawing every frame (ms each) "
           "| state frames/s on the page | sim s per wall s | bodies named | Foxglove messages/s (MB/s) |")
@@ -266,7 +285,7 @@ def main() -> int:
     for r in rows:
         print(f"| {r['case']} | {ms(r.get('latency'))} | {ms(r.get('latency_view'))} | {100 * r['cpu_page']:.0f} % "
               f"| {100 * r['cpu_fox']:.0f} % | {r['fps']:.0f} | {r['draws']:.0f} ({r['draw_ms']:.1f}) | {r['fps_all']:.0f} ({r['draw_ms_all']:.1f}) | {r['frames']:.0f} | {r['rtf']:.2f} "
-              f"| {r['named']} | {r['fox_msgs']:.0f} ({r['fox_mbps']:.2f}) |")
+              f"| {r['named']:.0f} | {r['fox_msgs']:.0f} ({r['fox_mbps']:.2f}) |")
     return 0
 
 
