@@ -33,6 +33,7 @@ def test_good_messages() -> None:
     assert parse('{"type": "step", "steps": 10}', BODIES).args == {"steps": 10}
     assert parse('{"type": "step"}', BODIES).args == {"steps": 1}
     assert parse('{"type": "reset"}', BODIES).type == "reset"
+    assert parse('{"type": "ack", "frame": 17}', BODIES).args == {"frame": 17}
 
 
 @pytest.mark.parametrize("text, reason", [
@@ -64,6 +65,9 @@ def test_good_messages() -> None:
     ('{"type": "step", "steps": 0}', "1..100000"),
     ('{"type": "step", "steps": 1000001}', "1..100000"),
     ('{"type": "reset", "id": "x"}', "id must be an integer"),
+    ('{"type": "ack", "frame": -1}', "frame must be an integer"),
+    ('{"type": "ack", "frame": 1.5}', "frame must be an integer"),
+    ('{"type": "ack"}', "frame must be an integer"),
     ('{"type": "launch"}', "unknown message type"),
     ('{"kind": "reset"}', "unknown message type"),
 ])

@@ -36,6 +36,10 @@ from collide_ros.view.bridge import ViewBridge, spin_in_thread
 PAGE = Path(__file__).with_name("page.html")
 MAX_PENDING = 8  # parameter/service requests per page waiting for the node at once
 HEARTBEAT = 1.0  # s: a state frame at least this often, even when nothing changed
+# state frames sent to a page and not acknowledged yet: a browser reads its WebSocket whatever its
+# page does, so only the page's acks tell that it keeps up; beyond this the due frames are skipped
+# and the next one sent carries the newest state. A client that never acks is not held back.
+WINDOW = 2
 
 
 def _response(status: HTTPStatus, body: bytes, content_type: str) -> Response:
@@ -91,7 +95,8 @@ class ViewServer:
         await send({"type": "hello", "client": client, "bodies": list(self.bridge.bodies),
                     "keymap": {k: list(v) for k, v in KEYMAP.items()}, "params": list(protocol.PARAMS),
                     "rate": 1.0 / self.period})
-        streamer = asyncio.create_task(self._stream(ws, send))
+        flow = _Flow()
+        streamer = asyncio.create_task(self._stream(ws, send, flow))
         limit = protocol.RateLimit()
         last_flood_notice = 0.0
         try:
@@ -108,7 +113,9 @@ class ViewServer:
                 except protocol.Refused as r:
                     await send({"type": "refused", "id": r.req_id, "reason": r.reason})
                     continue
-                if cmd.type == "spring":
+                if cmd.type == "ack":
+                    flow.acked = max(flow.acked or 0, min(cmd.args["frame"], flow.sent))
+                elif cmd.type == "spring":
                     self.bridge.spring(client, cmd.args["body"], cmd.args["point"], cmd.args["target"])
                 elif cmd.type == "release":
                     self.bridge.release(client)
@@ -133,7 +140,7 @@ class ViewServer:
         except Exception as exc:  # the page gets an answer whatever happens
             reply(False, f"view: {type(exc).__name__}: {exc}")
 
-    async def _stream(self, ws: ServerConnection, send: Any) -> None:
+    async def _stream(self, ws: ServerConnection, send: Any, flow: "_Flow") -> None:
         version = -1
         seq = -1
         last = 0.0
@@ -145,12 +152,24 @@ class ViewServer:
                     shapes = self.bridge.shapes()
                     version = shapes["version"]
                     await send(shapes)
-                if new_seq != seq or t0 - last >= HEARTBEAT or state["version"] != version:
+                due = new_seq != seq or t0 - last >= HEARTBEAT or state["version"] != version
+                if due and (flow.acked is None or flow.sent - flow.acked < WINDOW):
                     seq, last = new_seq, t0
+                    flow.sent += 1
+                    state["frame"] = flow.sent
                     await send(frames.encode_state(state))
                 await asyncio.sleep(max(0.0, self.period - (time.monotonic() - t0)))
         except (ConnectionClosed, asyncio.CancelledError):
             pass
+
+
+class _Flow:
+    """State frames sent to one page (numbered from 1) and the last one it acknowledged (None: it
+    has not acknowledged any, so it is not held back)."""
+
+    def __init__(self) -> None:
+        self.sent = 0
+        self.acked: int | None = None
 
 
 async def _safe(coro: Any) -> None:
