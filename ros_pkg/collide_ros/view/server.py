@@ -155,9 +155,15 @@ class ViewServer:
                 due = new_seq != seq or t0 - last >= HEARTBEAT or state["version"] != version
                 if due and (flow.acked is None or flow.sent - flow.acked < WINDOW):
                     seq, last = new_seq, t0
-                    flow.sent += 1
-                    state["frame"] = flow.sent
-                    await send(frames.encode_state(state))
+                    state["frame"] = flow.sent + 1
+                    try:
+                        data = frames.encode_state(state)
+                    except ValueError as exc:  # e.g. a NaN among the JSON values: this frame is skipped
+                        self.bridge.get_logger().warning(f"view: state frame not sent: {exc}",
+                                                         throttle_duration_sec=5.0)
+                    else:
+                        flow.sent += 1
+                        await send(data)
                 await asyncio.sleep(max(0.0, self.period - (time.monotonic() - t0)))
         except (ConnectionClosed, asyncio.CancelledError):
             pass
