@@ -1,7 +1,7 @@
 """Benchmark of the live view (python -m collide_ros.view): pointer -> spring latency, the view's CPU
 at 6 and 1000 bodies, the page's drawing rate in headless Chromium.
 
-    source scripts/env.sh && nice python bench/view_bench.py [--bodies 6 1000] [--trials 40] [--seconds 8]
+    source scripts/env.sh && nice python bench/view_bench.py [--bodies 6 1000] [--trials 40] [--seconds 8] [--repeat 1]
 
 Per case a sim node runs with bench/node_bench.py's parameters and scene (6: the default scene with
 blocks:=6; 1000: its generated scene of 1000 moving boxes), a view beside it with ``--foxglove``
@@ -17,9 +17,15 @@ Measured, in this order:
 - the view process's CPU share (utime + stime from /proc over --seconds), first with the page alone
   (the Foxglove server idle: nothing subscribed), then with a Foxglove client subscribed to /scene,
   /tf and /energy as well, reading every message;
-- the page: animation frames per second (a requestAnimationFrame counter beside the page's own
-  drawing, which runs in the same frames) and state frames per second received from the view, over
-  --seconds.
+- the page, over --seconds: animation frames per second (a requestAnimationFrame counter beside the
+  page's own), the page's draws of the scene per second (it draws when something changed: a new
+  state) and the mean time one draw takes (performance.now() around it: the script's work, not the
+  raster), state frames per second received from the view, and the sim seconds those frames advance per wall
+  second (the node's real-time factor: the node publishes bodies/states at 100 Hz of sim time, so
+  at most 100 x that many new states a second exist to be sent, and the view sends at most --rate,
+  30); then, over another --seconds, the animation frames per second and the time per draw with the
+  page drawing in every frame (``__view.drawEveryFrame``): whether it keeps 60 fps drawing; then how
+  many of the page's shapes the view named as the node's dynamic bodies.
 
 Not run by the tests (timings). Uses ROS_DOMAIN_ID from the environment, or picks a free one in the
 bench range 75-79. Prints a markdown table.
@@ -101,15 +107,19 @@ def cpu_share(pid: int, seconds: float) -> float:
     return (node_bench.cpu_seconds(pid) - c0) / (time.monotonic() - t0)
 
 
-def page_rates(page: Any, seconds: float) -> tuple[float, float]:
-    """(animation frames per second, state frames received per second) over ``seconds``."""
+def page_rates(page: Any, seconds: float, every_frame: bool = False) -> tuple[float, float, float, float, float]:
+    """(animation frames per second, the page's draws per second, its mean milliseconds per draw,
+    state frames received per second, sim seconds per wall second in those frames) over ``seconds``;
+    ``every_frame``: the page draws in every animation frame, not only when something changed."""
+    page.evaluate(f"window.__view.drawEveryFrame = {str(every_frame).lower()}")
     got = page.evaluate("""async (ms) => {
-      const f0 = window.__view.frames, t0 = performance.now(); let n = 0;
+      const V = window.__view, f0 = V.frames, d0 = V.draws, m0 = V.drawMs, s0 = V.t, t0 = performance.now(); let n = 0;
       await new Promise((ok) => { const tick = () => { n++; if (performance.now() - t0 < ms) requestAnimationFrame(tick);
                                                          else ok(); }; requestAnimationFrame(tick); });
-      const dt = (performance.now() - t0) / 1000;
-      return [n / dt, (window.__view.frames - f0) / dt]; }""", seconds * 1000.0)
-    return float(got[0]), float(got[1])
+      const dt = (performance.now() - t0) / 1000, draws = V.draws - d0;
+      return [n / dt, draws / dt, (V.drawMs - m0) / Math.max(1, draws), (V.frames - f0) / dt, (V.t - s0) / dt]; }""",
+                        seconds * 1000.0)
+    return float(got[0]), float(got[1]), float(got[2]), float(got[3]), float(got[4])
 
 
 def spring_latency(page: Any, echoes: list[tuple[float, float]], lock: threading.Lock, trials: int) -> list[float]:
@@ -190,7 +200,10 @@ def run_case(label: str, trials: int, seconds: float) -> dict[str, Any]:
                 res["latency_view"] = spring_latency(page, sent, lock, trials)
                 res["lost"] = 2 * trials - len(res["latency"]) - len(res["latency_view"])
             res["cpu_page"] = cpu_share(view.proc.pid, seconds)
-            res["fps"], res["frames"] = page_rates(page, seconds)
+            res["fps"], res["draws"], res["draw_ms"], res["frames"], res["rtf"] = page_rates(page, seconds)
+            res["fps_all"], _, res["draw_ms_all"], _, _ = page_rates(page, seconds, every_frame=True)
+            page_rates(page, 0.0)  # back to drawing on change
+            res["named"] = page.evaluate("window.__view.shapes.filter((b) => b.name).length")
             assert view.foxglove_port
             fox = FoxgloveReader(view.foxglove_port)
             m0, b0, t0 = fox.messages, fox.bytes, time.monotonic()
@@ -212,6 +225,17 @@ def run_case(label: str, trials: int, seconds: float) -> dict[str, Any]:
     return res
 
 
+def median_of(runs: list[dict[str, Any]]) -> dict[str, Any]:
+    """One row from the runs of a case: the median of each figure, the latency samples pooled."""
+    out: dict[str, Any] = {"case": runs[0]["case"]}
+    for key, value in runs[0].items():
+        if key.startswith("latency"):
+            out[key] = [x for r in runs for x in r[key]]
+        elif isinstance(value, (int, float)):
+            out[key] = statistics.median(r[key] for r in runs)
+    return out
+
+
 def _spin(ex: Any, ctx: Any) -> None:
     while ctx.ok():
         try:
@@ -225,6 +249,9 @@ def main() -> int:
     p.add_argument("--bodies", nargs="+", default=["6", "1000"], help="cases (node_bench's: 6, 1000, ...)")
     p.add_argument("--trials", type=int, default=40, help="pointer moves for the latency (6 bodies)")
     p.add_argument("--seconds", type=float, default=8.0, help="wall seconds of each CPU and frame-rate window")
+    p.add_argument("--repeat", type=int, default=1,
+                   help="runs of each case (each a fresh node, view and browser); the table gives the median "
+                        "of every figure over the runs, the latencies pooled")
     a = p.parse_args()
     if not os.access(CHROMIUM, os.X_OK):
         print(f"view_bench: {CHROMIUM} is missing; run scripts/setup", file=sys.stderr)
@@ -236,24 +263,29 @@ def main() -> int:
     rows = []
     try:
         for label in a.bodies:
-            r = run_case(label, a.trials if int(label) <= 6 else 0, a.seconds)
-            rows.append(r)
-            print(f"  {label}: {json.dumps({k: v for k, v in r.items() if not k.startswith('latency')})}", flush=True)
+            runs = []
+            for _ in range(max(1, a.repeat)):
+                r = run_case(label, a.trials if int(label) <= 6 else 0, a.seconds)
+                runs.append(r)
+                print(f"  {label}: {json.dumps({k: v for k, v in r.items() if not k.startswith('latency')})}",
+                      flush=True)
+            rows.append(median_of(runs))
     finally:
         if lock is not None:
             lock.release()
-    print(f"load average at the end: {' '.join(f'{x:.1f}' for x in os.getloadavg())}")
+    print(f"load average at the end: {' '.join(f'{x:.1f}' for x in os.getloadavg())}; "
+          f"{max(1, a.repeat)} run(s) per case")
     print("\n| bodies | pointer -> node's echo p50 / p90 (ms) | pointer -> view's spring p50 / p90 (ms) "
-          "| view CPU, page | view CPU, page + Foxglove client | page fps (drawing) | state frames/s on the page "
-          "| Foxglove messages/s (MB/s) |")
-    print("|---|---|---|---|---|---|---|---|")
+          "| view CPU, page | view CPU, page + Foxglove client | page fps (animation frames) | page draws/s (ms each) | page fps drawing every frame (ms each) "
+          "| state frames/s on the page | sim s per wall s | bodies named | Foxglove messages/s (MB/s) |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
 
     def ms(lat: list[float] | None) -> str:
         return f"{1e3 * statistics.median(lat):.0f} / {1e3 * percentile(lat, 0.9):.0f}" if lat else "-"
     for r in rows:
         print(f"| {r['case']} | {ms(r.get('latency'))} | {ms(r.get('latency_view'))} | {100 * r['cpu_page']:.0f} % "
-              f"| {100 * r['cpu_fox']:.0f} % | {r['fps']:.0f} | {r['frames']:.0f} "
-              f"| {r['fox_msgs']:.0f} ({r['fox_mbps']:.2f}) |")
+              f"| {100 * r['cpu_fox']:.0f} % | {r['fps']:.0f} | {r['draws']:.0f} ({r['draw_ms']:.1f}) | {r['fps_all']:.0f} ({r['draw_ms_all']:.1f}) | {r['frames']:.0f} | {r['rtf']:.2f} "
+              f"| {r['named']:.0f} | {r['fox_msgs']:.0f} ({r['fox_mbps']:.2f}) |")
     return 0
 
 

@@ -1,15 +1,14 @@
-"""The live view without ROS or a browser: what a page may send (protocol.py) and how the view
-builds its scene from the node's topics (scene.py)."""
+"""The live view without ROS or a browser: what a page may send (protocol.py), how the view
+builds its scene from the node's topics (scene.py) and the state frame it sends (frames.py)."""
 from __future__ import annotations
 
-import json
-from types import SimpleNamespace as NS
-
+import numpy as np
 import pytest
 
-from collide_ros.view import protocol
+from collide_ros.view import frames, protocol
+from collide_ros.view.cdr_in import Markers
 from collide_ros.view.protocol import Refused, parse
-from collide_ros.view.scene import SceneState, match_rows
+from collide_ros.view.scene import CONTACT_HOLD, MAX_CONTACTS, SceneState, match_rows
 
 BODIES = frozenset({"block1", "block2"})
 
@@ -34,6 +33,7 @@ def test_good_messages() -> None:
     assert parse('{"type": "step", "steps": 10}', BODIES).args == {"steps": 10}
     assert parse('{"type": "step"}', BODIES).args == {"steps": 1}
     assert parse('{"type": "reset"}', BODIES).type == "reset"
+    assert parse('{"type": "ack", "frame": 17}', BODIES).args == {"frame": 17}
 
 
 @pytest.mark.parametrize("text, reason", [
@@ -65,6 +65,9 @@ def test_good_messages() -> None:
     ('{"type": "step", "steps": 0}', "1..100000"),
     ('{"type": "step", "steps": 1000001}', "1..100000"),
     ('{"type": "reset", "id": "x"}', "id must be an integer"),
+    ('{"type": "ack", "frame": -1}', "frame must be an integer"),
+    ('{"type": "ack", "frame": 1.5}', "frame must be an integer"),
+    ('{"type": "ack"}', "frame must be an integer"),
     ('{"type": "launch"}', "unknown message type"),
     ('{"kind": "reset"}', "unknown message type"),
 ])
@@ -92,15 +95,16 @@ def test_rate_limit_refuses_floods() -> None:
 
 
 # ---------------------------------------------------------------- scene
-def marker(ns: str, mid: int, x: float, y: float, pts: list[tuple[float, float]] | None = None,
-           action: int = 0) -> NS:
-    q = NS(x=0.0, y=0.0, z=0.0, w=1.0)
-    points = [NS(x=a, y=b, z=0.0) for a, b in (pts or [])]
-    return NS(ns=ns, id=mid, action=action, pose=NS(position=NS(x=x, y=y, z=0.0), orientation=q),
-              points=points, color=NS(r=0.2, g=0.75, b=0.2, a=1.0))
+SQUARE = [(-0.5, -0.5), (0.5, -0.5), (0.5, 0.5), (-0.5, 0.5)]
+GREEN = "#33bf33"
 
 
-SQUARE = [(-0.5, -0.5), (0.5, -0.5), (0.5, 0.5), (-0.5, 0.5), (-0.5, -0.5)]
+def markers(stamp: float, bodies: list[tuple[int, float, float]], springs: list[list[float]] | None = None,
+            delete_alls: int = 0) -> Markers:
+    """A markers message as cdr_in reads it: bodies (id, x, y), squares at yaw 0."""
+    return Markers(delete_alls=delete_alls, stamp=stamp, ids=[b[0] for b in bodies],
+                   verts=[[list(p) for p in SQUARE] for _ in bodies], colors=[GREEN] * len(bodies),
+                   poses=np.array([[x, y, 0.0] for _, x, y in bodies]).reshape(-1, 3), springs=springs or [])
 
 
 def test_match_rows_in_order() -> None:
@@ -112,33 +116,38 @@ def test_match_rows_in_order() -> None:
 def test_scene_names_dynamic_bodies_by_matching_poses() -> None:
     s = SceneState()
     s.on_states(1.0, ["block1"], [(1.0, 2.0, 0.0)], [(0.0, 0.0, 0.0)], wall=0.0)
-    s.on_markers(1.0, [marker("bodies", 10, 0.0, -6.0, SQUARE), marker("bodies", 11, 1.0, 2.0, SQUARE),
-                       marker("springs", 0, 0, 0, [(1.0, 2.0), (3.0, 3.0)])])
+    s.on_markers(markers(1.0, [(10, 0.0, -6.0), (11, 1.0, 2.0)], springs=[[1.0, 2.0, 3.0, 3.0]]))
     msg = s.shapes_message()
     assert [(b["id"], b["name"], b["static"]) for b in msg["bodies"]] == [(10, None, True), (11, "block1", False)]
-    assert msg["bodies"][1]["verts"] == [list(p) for p in SQUARE[:-1]]
+    assert msg["bodies"][1]["verts"] == [list(p) for p in SQUARE]
     assert s.dynamic_bodies() == {"block1"}
     # later states move block1; the state message takes its pose from bodies/states
     s.on_states(1.01, ["block1"], [(1.5, 2.0, 0.1)], [(1.0, 0.0, 0.0)], wall=0.6)
-    st = json.loads(json.dumps(s.state_message(wall=0.6)))
-    assert st["poses"] == [[0.0, -6.0, 0.0], [1.5, 2.0, 0.1]]
+    st = s.state_message(wall=0.6)
+    assert st["poses"].tolist() == [[0.0, -6.0, 0.0], [1.5, 2.0, 0.1]]
+    # a velocity for the named body only; the wall has none (NaN)
+    assert np.isnan(st["velocities"][0]).all() and st["velocities"][1].tolist() == [1.0, 0.0, 0.0]
     assert st["springs"] == [[1.0, 2.0, 3.0, 3.0]]
     assert st["rtf"] == pytest.approx(0.01 / 0.6)
+    # the page's frame carries the same values
+    back = frames.decode_state(frames.encode_state({**st, "node": True, "health": None, "params": {}}))
+    assert back["poses"].tolist() == st["poses"].tolist() and back["springs"] == st["springs"]
+    assert back["type"] == "state" and back["bodies"] == 2 and back["points"] == 0
 
 
 def test_scene_delete_all_and_energy_start() -> None:
     s = SceneState()
-    s.on_markers(0.0, [marker("bodies", 1, 0.0, 0.0, SQUARE)])
+    s.on_markers(markers(0.0, [(1, 0.0, 0.0)]))
     s.on_energy({"total": 5.0, "translational": 5.0, "rotational": 0.0, "potential": 0.0})
     s.on_energy({"total": 4.0, "translational": 4.0, "rotational": 0.0, "potential": 0.0})
     assert s.state_message()["energy"]["start"] == 5.0
     v = s.shapes_version
-    s.on_markers(2.0, [marker("", 0, 0.0, 0.0, action=3), marker("bodies", 1, 0.0, 0.0, SQUARE)])
+    s.on_markers(markers(2.0, [(1, 0.0, 0.0)], delete_alls=1))
     assert s.resets == 1 and s.shapes_version > v and s.energy_start is None
     s.on_energy({"total": 1.0, "translational": 1.0, "rotational": 0.0, "potential": 0.0})
     assert s.state_message()["energy"]["start"] == 1.0
     # a body that is no longer among the markers (killed) goes
-    s.on_markers(3.0, [marker("bodies", 2, 0.0, 0.0, SQUARE)])
+    s.on_markers(markers(3.0, [(2, 0.0, 0.0)]))
     assert [b["id"] for b in s.shapes_message()["bodies"]] == [2]
 
 
@@ -147,14 +156,21 @@ def test_scene_spawn_within_a_step_names_the_new_body() -> None:
     # same stamp; the next states name all three
     s = SceneState()
     s.on_states(1.0, ["a", "b"], [(1.0, 0.0, 0.0), (2.0, 0.0, 0.0)], [(0.0, 0.0, 0.0)] * 2, wall=0.0)
-    walls_and = [marker("bodies", 1, 0.0, -6.0, SQUARE), marker("bodies", 2, 1.0, 0.0, SQUARE),
-                 marker("bodies", 3, 2.0, 0.0, SQUARE)]
-    s.on_markers(1.0, walls_and)
+    walls_and = [(1, 0.0, -6.0), (2, 1.0, 0.0), (3, 2.0, 0.0)]
+    s.on_markers(markers(1.0, walls_and))
     assert s.matched and s.name_of == {2: "a", 3: "b"}
-    s.on_markers(1.0, walls_and + [marker("bodies", 4, 0.0, 3.0, SQUARE)])
+    s.on_markers(markers(1.0, walls_and + [(4, 0.0, 3.0)]))
     s.on_states(1.01, ["a", "b", "crate"], [(1.0, 0.0, 0.0), (2.0, 0.0, 0.0), (0.0, 3.0, 0.0)],
                 [(0.0, 0.0, 0.0)] * 3, wall=0.1)
     assert not s.matched  # the body set changed: named again with the next markers
-    s.on_markers(1.01, walls_and + [marker("bodies", 4, 0.0, 3.0, SQUARE)])
+    s.on_markers(markers(1.01, walls_and + [(4, 0.0, 3.0)]))
     assert s.matched and s.name_of == {2: "a", 3: "b", 4: "crate"}
     assert [b["static"] for b in s.shapes_message()["bodies"]] == [True, False, False, False]
+
+
+def test_scene_contacts_held_and_capped() -> None:
+    s = SceneState()
+    s.on_contacts(np.ones((3, 2)), wall=0.0)
+    s.on_contacts(np.zeros((MAX_CONTACTS, 2)), wall=0.1)
+    assert len(s.state_message(wall=0.1)["contacts"]) == MAX_CONTACTS  # both held, the sum capped
+    assert len(s.state_message(wall=0.1 + CONTACT_HOLD + 0.01)["contacts"]) == 0  # both older than the hold

@@ -22,12 +22,12 @@ from std_srvs.srv import Empty, SetBool
 from visualization_msgs.msg import MarkerArray
 
 from collide_ros import qos
-from collide_ros.cdr import join_time
 from collide_ros.diag_name import physics_status, sim_node_name
 from collide_ros.params import frame_prefix_for
 from collide_ros.teleop import N_THRUSTERS, firing_for
+from collide_ros.view import cdr_in
 from collide_ros.view.protocol import PARAMS
-from collide_ros.view.scene import SceneState, yaw_of
+from collide_ros.view.scene import MAX_CONTACTS, SceneState
 
 THRUSTER_PERIOD = 0.1   # s: held thrusters are republished (the node drops a command after command_timeout)
 SERVICE_WAIT = 5.0      # s: how long a request waits for the node's service to appear
@@ -74,9 +74,13 @@ class ViewBridge(Node):
         # the sim names its /diagnostics status by its fully qualified name (/sim, /robot1/sim): the one
         # in this view's namespace, so a view beside several sims shows its own sim's health
         self._diag_name = physics_status(sim_node_name(self.get_namespace(), sim))
-        self.create_subscription(BodyStates, "bodies/states", self._on_states, LATEST)
-        self.create_subscription(MarkerArray, "markers", self._on_markers, LATCHED)
-        self.create_subscription(Contacts, "contacts", self._on_contacts, LATEST)
+        # the bulk topics arrive as CDR bytes, read by cdr_in (rclpy's message objects cost ~0.1 s
+        # per message at 1 000 bodies); the readers keep what did not change since the last message
+        self._states_in = cdr_in.StatesReader()
+        self._markers_in = cdr_in.MarkersReader()
+        self.create_subscription(BodyStates, "bodies/states", self._on_states, LATEST, raw=True)
+        self.create_subscription(MarkerArray, "markers", self._on_markers, LATCHED, raw=True)
+        self.create_subscription(Contacts, "contacts", self._on_contacts, LATEST, raw=True)
         self.create_subscription(Energy, "energy", self._on_energy, LATEST)
         self.create_subscription(DiagnosticArray, "/diagnostics", self._on_diag, 10)
         self._pub_spring = self.create_publisher(SpringCommand, "spring", qos.COMMAND)
@@ -95,24 +99,34 @@ class ViewBridge(Node):
         self.create_timer(WATCH_PERIOD, self._watch)
 
     # ---------------------------------------------------------------- topics in
-    def _on_states(self, m: BodyStates) -> None:
-        poses = [(p.position.x, p.position.y, yaw_of(p.orientation)) for p in m.poses]
-        twists = [(t.linear.x, t.linear.y, t.angular.z) for t in m.twists]
+    def _unreadable(self, topic: str, exc: Exception) -> None:
+        self.get_logger().warning(f"view: {topic}: message skipped: {exc}", throttle_duration_sec=5.0)
+
+    def _on_states(self, raw: bytes) -> None:
+        try:
+            m = self._states_in.read(raw)
+        except ValueError as exc:
+            self._unreadable("bodies/states", exc)
+            return
         with self.lock:
-            self.scene.on_states(join_time(m.header.stamp), list(m.names), poses, twists)
+            self.scene.on_states(m.stamp, m.names, m.poses, m.twists)
             self.node_alive = True
 
-    def _on_markers(self, m: MarkerArray) -> None:
-        stamp = None
-        for mk in m.markers:
-            if mk.ns == "bodies":
-                stamp = join_time(mk.header.stamp)
-                break
+    def _on_markers(self, raw: bytes) -> None:
+        try:
+            m = self._markers_in.read(raw)
+        except ValueError as exc:
+            self._unreadable("markers", exc)
+            return
         with self.lock:
-            self.scene.on_markers(stamp, list(m.markers))
+            self.scene.on_markers(m)
 
-    def _on_contacts(self, m: Contacts) -> None:
-        pts = [[c.point.x, c.point.y] for c in m.contacts]
+    def _on_contacts(self, raw: bytes) -> None:
+        try:
+            _stamp, pts = cdr_in.contact_points(raw, MAX_CONTACTS)
+        except ValueError as exc:
+            self._unreadable("contacts", exc)
+            return
         with self.lock:
             self.scene.on_contacts(pts)
 

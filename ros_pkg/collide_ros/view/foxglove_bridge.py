@@ -135,16 +135,16 @@ class FoxgloveStream:
             return  # the frames' names first (the node's parameters)
         if len(state["poses"]) != len(self._parts):
             return  # the shapes changed since the snapshot: the next frame has both
-        if not self._named and state["velocities"] and time.monotonic() - self._shapes_at < UNNAMED_WAIT:
+        if not self._named and state["dynamic"] and time.monotonic() - self._shapes_at < UNNAMED_WAIT:
             return  # right after the shapes change: names first, so that no entity id flickers
         assert self._frames is not None
         world = self._frames[0]
         stamp = wire.timestamp(state["t"])
         frame = wire.string_field(2, world)
-        poses = state["poses"]
+        poses = state["poses"].tolist()
         if self._scene.has_sinks():
             ids = set(self._ids) | {"contacts", "springs"}
-            extras = [wire.points_entity(stamp, frame, "contacts", state["contacts"]),
+            extras = [wire.points_entity(stamp, frame, "contacts", state["contacts"].tolist()),
                       wire.lines_entity(stamp, frame, "springs", state["springs"])]
             gone = sorted(self._sent_ids - ids)
             self._scene.log(wire.scene_update(stamp, frame, self._parts, poses, extras, gone))

@@ -10,6 +10,7 @@ docs/live_view.md.
     {"type": "keys", "held": ["s", "e"]}                 # the thruster keys held now (teleop.KEYMAP)
     {"type": "param", "name": "gravity", "value": 9.81}  # set one of PARAMS on the node
     {"type": "pause", "paused": true} | {"type": "step", "steps": 10} | {"type": "reset"}
+    {"type": "ack", "frame": 17}                         # the page has handled state frame 17
 
 A request may carry ``"id"`` (an integer), echoed in the reply or the refusal.
 """
@@ -135,6 +136,11 @@ def parse(text: str | bytes, bodies: set[str] | frozenset[str]) -> Command:
             return Command("step", req_id, {"steps": steps})
         if kind == "reset":
             return Command("reset", req_id)
+        if kind == "ack":
+            frame = msg.get("frame")
+            if isinstance(frame, bool) or not isinstance(frame, int) or not 0 <= frame <= 2**53:
+                raise Refused("ack: frame must be an integer >= 0", req_id)
+            return Command("ack", req_id, {"frame": frame})
     except OverflowError:
         raise Refused("number too large", req_id) from None
     raise Refused(f"unknown message type {str(kind)[:32]!r}", req_id)

@@ -4,8 +4,9 @@
                                [--ros-args -r __ns:=/robot1]
 
 HTTP and the WebSocket share one port (websockets' ``process_request`` serves the page). Each page
-gets the latest state at ``--rate`` Hz: a frame is built from the newest data when it is due and
-sent before the next one is built, so a slow page gets fewer frames, never a backlog. ``--foxglove``
+gets the latest state at ``--rate`` Hz as a binary frame (frames.py): a frame is built from the newest
+data when it is due and sent before the next one is built, so a slow page gets fewer frames, never a
+backlog. ``--foxglove``
 also serves the scene over the Foxglove WebSocket protocol (foxglove_bridge.py) on the same host.
 """
 from __future__ import annotations
@@ -29,12 +30,16 @@ from websockets.exceptions import ConnectionClosed
 from websockets.http11 import Request, Response
 
 from collide_ros.teleop import KEYMAP
-from collide_ros.view import protocol
+from collide_ros.view import frames, protocol
 from collide_ros.view.bridge import ViewBridge, spin_in_thread
 
 PAGE = Path(__file__).with_name("page.html")
 MAX_PENDING = 8  # parameter/service requests per page waiting for the node at once
 HEARTBEAT = 1.0  # s: a state frame at least this often, even when nothing changed
+# state frames sent to a page and not acknowledged yet: a browser reads its WebSocket whatever its
+# page does, so only the page's acks tell that it keeps up; beyond this the due frames are skipped
+# and the next one sent carries the newest state. A client that never acks is not held back.
+WINDOW = 2
 
 
 def _response(status: HTTPStatus, body: bytes, content_type: str) -> Response:
@@ -75,9 +80,10 @@ class ViewServer:
             pending[0] -= 1
         loop = asyncio.get_running_loop()
 
-        async def send(obj: dict[str, Any]) -> None:
+        async def send(obj: dict[str, Any] | bytes) -> None:
+            """A JSON text message, or bytes as one binary message (a state frame)."""
             async with send_lock:
-                await ws.send(json.dumps(obj, allow_nan=False, default=float))
+                await ws.send(obj if isinstance(obj, bytes) else json.dumps(obj, allow_nan=False, default=float))
 
         def reply_soon(req_id: int | None, kind: str) -> Any:
             def reply(ok: bool, message: str) -> None:  # on the executor thread
@@ -89,7 +95,8 @@ class ViewServer:
         await send({"type": "hello", "client": client, "bodies": list(self.bridge.bodies),
                     "keymap": {k: list(v) for k, v in KEYMAP.items()}, "params": list(protocol.PARAMS),
                     "rate": 1.0 / self.period})
-        streamer = asyncio.create_task(self._stream(ws, send))
+        flow = _Flow()
+        streamer = asyncio.create_task(self._stream(ws, send, flow))
         limit = protocol.RateLimit()
         last_flood_notice = 0.0
         try:
@@ -106,7 +113,9 @@ class ViewServer:
                 except protocol.Refused as r:
                     await send({"type": "refused", "id": r.req_id, "reason": r.reason})
                     continue
-                if cmd.type == "spring":
+                if cmd.type == "ack":
+                    flow.acked = max(flow.acked or 0, min(cmd.args["frame"], flow.sent))
+                elif cmd.type == "spring":
                     self.bridge.spring(client, cmd.args["body"], cmd.args["point"], cmd.args["target"])
                 elif cmd.type == "release":
                     self.bridge.release(client)
@@ -131,7 +140,7 @@ class ViewServer:
         except Exception as exc:  # the page gets an answer whatever happens
             reply(False, f"view: {type(exc).__name__}: {exc}")
 
-    async def _stream(self, ws: ServerConnection, send: Any) -> None:
+    async def _stream(self, ws: ServerConnection, send: Any, flow: "_Flow") -> None:
         version = -1
         seq = -1
         last = 0.0
@@ -143,12 +152,30 @@ class ViewServer:
                     shapes = self.bridge.shapes()
                     version = shapes["version"]
                     await send(shapes)
-                if new_seq != seq or t0 - last >= HEARTBEAT or state["version"] != version:
+                due = new_seq != seq or t0 - last >= HEARTBEAT or state["version"] != version
+                if due and (flow.acked is None or flow.sent - flow.acked < WINDOW):
                     seq, last = new_seq, t0
-                    await send(state)
+                    state["frame"] = flow.sent + 1
+                    try:
+                        data = frames.encode_state(state)
+                    except ValueError as exc:  # e.g. a NaN among the JSON values: this frame is skipped
+                        self.bridge.get_logger().warning(f"view: state frame not sent: {exc}",
+                                                         throttle_duration_sec=5.0)
+                    else:
+                        flow.sent += 1
+                        await send(data)
                 await asyncio.sleep(max(0.0, self.period - (time.monotonic() - t0)))
         except (ConnectionClosed, asyncio.CancelledError):
             pass
+
+
+class _Flow:
+    """State frames sent to one page (numbered from 1) and the last one it acknowledged (None: it
+    has not acknowledged any, so it is not held back)."""
+
+    def __init__(self) -> None:
+        self.sent = 0
+        self.acked: int | None = None
 
 
 async def _safe(coro: Any) -> None:
