@@ -9,7 +9,9 @@ publisher is reliable, transient_local only if every publisher is. Message defin
 RIHS01 type hashes come from the installed interface packages (libcollide_msgs and our
 rebuilt tf2_msgs) and from rosbags' Jazzy typestore for the standard messages; the hash of
 our own types is checked against the hash rosidl generated. Stops on --duration, SIGINT or
-SIGTERM, then prints the message count per topic. The bag's metadata (metadata.yaml and the MCAP
+SIGTERM, then prints the message count per topic. A node's ``~/snapshot`` (libcollide_msgs/WorldSnapshot)
+is always recorded, --topics or not, and the recorder asks for a fresh one when it subscribes (it prints
+``recorder: state saved on <topic>`` once the node has answered): the state a replay starts from. The bag's metadata (metadata.yaml and the MCAP
 file's own copy) says ``ros_distro: jazzy``.
 """
 from __future__ import annotations
@@ -30,6 +32,10 @@ from typing import Any, Iterable
 EXCLUDED = frozenset({"/rosout", "/parameter_events"})
 OWN_PACKAGES = ("libcollide_msgs", "tf2_msgs")
 COMMAND_TOPICS = ("thrusters", "spring", "cmd_vel")  # plus every "<body>/thrust"
+#: always recorded, --topics or not: the sim's state a replay starts from. On subscribing, the recorder
+#: calls the node's save service (the topic's sibling), so the bag holds the state at its start.
+SNAPSHOT_TYPE = "libcollide_msgs/msg/WorldSnapshot"
+SAVE_SERVICE = "save_snapshot"
 #: the bag's ros_distro (metadata.yaml and the MCAP file's rosbag2 metadata record): the ROS 2
 #: release whose bag format, message definitions and type hashes the bag has. rosbags writes
 #: "rosbags" there and has no option for it, so the recorder rewrites it (_set_ros_distro).
@@ -149,6 +155,8 @@ class Recorder:
         self.subs: dict[str, Any] = {}
         self.conns: dict[str, Any] = {}
         self.counts: dict[str, int] = {}
+        self._snapshot_clients: list[Any] = []
+        self.saved: list[str] = []  # snapshot topics whose node answered ~/save_snapshot
         self.closed = False
         self._timer = node.create_timer(0.2, self.discover)
         self.discover()
@@ -167,7 +175,7 @@ class Recorder:
             if self.wanted is None:
                 if name in EXCLUDED:
                     continue
-            elif name not in self.wanted:
+            elif name not in self.wanted and types[0] != SNAPSHOT_TYPE:
                 continue
             pubs = [p for p in self.node.get_publishers_info_by_topic(name)
                     if p.node_name != self.node.get_name()
@@ -207,6 +215,26 @@ class Recorder:
             self.counts[topic] += 1
 
         self.subs[topic] = self.node.create_subscription(cls, topic, cb, qos, raw=True)
+        if msgtype == SNAPSHOT_TYPE:
+            self._request_snapshot(topic)
+
+    def _request_snapshot(self, topic: str) -> None:
+        """Ask the node for its state now (it answers on ``topic``, which is recorded from here on)."""
+        from std_srvs.srv import Trigger
+
+        cli = self.node.create_client(Trigger, topic.rsplit("/", 1)[0] + "/" + SAVE_SERVICE)
+        self._snapshot_clients.append(cli)
+
+        def done(fut: Any) -> None:
+            res = fut.result()
+            if res is not None and res.success:
+                self.saved.append(topic)  # the state is on `topic`, after it what the bag holds
+
+        def call() -> None:
+            if cli.service_is_ready():
+                timer.cancel()
+                cli.call_async(Trigger.Request()).add_done_callback(done)
+        timer = self.node.create_timer(0.05, call)
 
     def subscribed(self) -> list[str]:
         return sorted(t for t, s in self.subs.items() if s is not None)
@@ -318,6 +346,7 @@ def main(argv: list[str] | None = None) -> int:
     print(f"recorder: writing {a.out} (mcap, rosbag2 v9)", flush=True)
     t_end = time.monotonic() + a.duration if a.duration > 0 else float("inf")
     announced: set[str] = set()
+    saved: list[str] = []
     try:
         while not stop["flag"] and time.monotonic() < t_end:
             ex.spin_once(timeout_sec=0.05)
@@ -325,6 +354,9 @@ def main(argv: list[str] | None = None) -> int:
             for t in sorted(new):
                 print(f"recorder: subscribed {t}", flush=True)
             announced |= new
+            while len(saved) < len(rec.saved):
+                saved.append(rec.saved[len(saved)])
+                print(f"recorder: state saved on {saved[-1]}", flush=True)
     finally:
         counts = rec.close()
         ex.remove_node(node)

@@ -10,6 +10,7 @@ stepping      one physics step, split into parts when C undoes it, and what is d
 publishing    poses, states, contacts, energy, /tf, markers, /clock
 diagnostics   the /diagnostics status
 services      ~/reset, ~/pause, ~/step, ~/kill
+snapshots     ~/snapshot (the state a replay starts from) and ~/save_snapshot
 spawning      ~/spawn and its checks (inside the static bodies' box, no overlap)
 loop          the sleep-until stepping loop and the executor thread
 
