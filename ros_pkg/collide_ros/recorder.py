@@ -9,10 +9,11 @@ publisher is reliable, transient_local only if every publisher is. Message defin
 RIHS01 type hashes come from the installed interface packages (libcollide_msgs and our
 rebuilt tf2_msgs) and from rosbags' Jazzy typestore for the standard messages; the hash of
 our own types is checked against the hash rosidl generated. Stops on --duration, SIGINT or
-SIGTERM, then prints the message count per topic. A node's ``~/snapshot`` (libcollide_msgs/WorldSnapshot)
-is always recorded, --topics or not, and the recorder asks for a fresh one when it subscribes (it prints
-``recorder: state saved on <topic>`` once the node has answered): the state a replay starts from. The bag's metadata (metadata.yaml and the MCAP
-file's own copy) says ``ros_distro: jazzy``.
+SIGTERM, then prints the message count per topic. A node's ``~/snapshot``
+(libcollide_msgs/WorldSnapshot, the state a replay starts from) is always recorded, --topics or
+not; the recorder asks the node for a fresh one when it subscribes and prints ``recorder: state
+saved on <topic>`` once that is in the bag. The bag's metadata (metadata.yaml and the MCAP file's
+own copy) says ``ros_distro: jazzy``.
 """
 from __future__ import annotations
 
@@ -25,7 +26,7 @@ import signal
 import sys
 import time
 from pathlib import Path
-from typing import Any, Iterable
+from typing import Any, Callable, Iterable
 
 #: topics recorded when --topics is not given and nothing else is discovered; more are
 #: picked up from the graph as they appear (all topics except the excluded ones)
@@ -156,6 +157,7 @@ class Recorder:
         self.conns: dict[str, Any] = {}
         self.counts: dict[str, int] = {}
         self._snapshot_clients: list[Any] = []
+        self._snapshot_requests: dict[str, Callable[[], None]] = {}
         self.saved: list[str] = []  # snapshot topics whose node answered ~/save_snapshot
         self.closed = False
         self._timer = node.create_timer(0.2, self.discover)
@@ -213,28 +215,39 @@ class Recorder:
             ts = info["received_timestamp"] if isinstance(info, dict) else time.time_ns()
             self.writer.write(conn, int(ts), data)
             self.counts[topic] += 1
+            if topic in self._snapshot_requests:
+                self._snapshot_requests[topic]()
 
         self.subs[topic] = self.node.create_subscription(cls, topic, cb, qos, raw=True)
         if msgtype == SNAPSHOT_TYPE:
-            self._request_snapshot(topic)
+            self._snapshot_requests[topic] = self._request_snapshot(topic)
 
-    def _request_snapshot(self, topic: str) -> None:
-        """Ask the node for its state now (it answers on ``topic``, which is recorded from here on)."""
+    def _request_snapshot(self, topic: str) -> Callable[[], None]:
+        """Ask the node for its state now; returns what the topic's callback calls on each message.
+
+        The node's latched snapshot (from its start or last reset) arrives first; after it, the
+        recorder calls ~/save_snapshot once (a ready service takes the request), and the next message
+        on ``topic`` is the state from the call on. The service's answer is not waited for: an answer
+        sent before its DDS reader has matched is dropped, so the fresh message is the proof."""
         from std_srvs.srv import Trigger
 
         cli = self.node.create_client(Trigger, topic.rsplit("/", 1)[0] + "/" + SAVE_SERVICE)
         self._snapshot_clients.append(cli)
-
-        def done(fut: Any) -> None:
-            res = fut.result()
-            if res is not None and res.success:
-                self.saved.append(topic)  # the state is on `topic`, after it what the bag holds
+        st = {"seen": False, "sent": False, "done": False}
 
         def call() -> None:
-            if cli.service_is_ready():
+            if st["seen"] and cli.service_is_ready():
+                st["sent"] = True
                 timer.cancel()
-                cli.call_async(Trigger.Request()).add_done_callback(done)
+                cli.call_async(Trigger.Request())
+
+        def on_message() -> None:
+            if st["sent"] and not st["done"]:
+                st["done"] = True
+                self.saved.append(topic)  # the state from the call on is in the bag
+            st["seen"] = True
         timer = self.node.create_timer(0.05, call)
+        return on_message
 
     def subscribed(self) -> list[str]:
         return sorted(t for t, s in self.subs.items() if s is not None)
@@ -319,7 +332,7 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--node-name", default="recorder")
     p.add_argument("--params-of", default=None, metavar="NODE",
                    help="store this node's parameters (e.g. 'sim') in the bag's custom_data, "
-                        "for replay")
+                        "for readers of the bag (the replay takes them from the node's ~/snapshot)")
     a = p.parse_args(argv)
     if Path(a.out).exists():
         p.error(f"{a.out} exists already")
