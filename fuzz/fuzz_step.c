@@ -150,7 +150,7 @@ static lc_status fz_check(const lc_world *w, lc_status s, uint64_t hash_before, 
 {
     char msg[512];
     if (s == LC_OK) return s;
-    if (s < LC_OK || s > LC_ERR_BAD_ENUM) {
+    if (s < LC_OK || s > LC_ERR_CALLBACK) {
         snprintf(msg, sizeof msg, "%s returned unknown status %d", call, (int)s);
         fz_fail(msg, NULL);
     }

@@ -195,7 +195,7 @@ static int applied(island_ctx *c)
     int nb = c->b.n, i;
     double *acc = lc_buf_get(&c->cr->b_acc, (size_t)(w->count > 0 ? w->count : 1) * 3 * sizeof(double));
     if (acc == NULL) return -1;
-    lc_applied_accelerations(w, w->state, c->isl->rows, nb, acc);
+    if (lc_applied_accelerations(w, w->state, c->isl->rows, nb, acc) != 0) return -1;
     for (i = 0; i < nb; ++i) memcpy(&c->b.acc[i * 3], &acc[c->isl->rows[i] * 3], 3 * sizeof(double));
     return 0;
 }
@@ -523,7 +523,7 @@ static double island_energy(const lc_world *w, const lc_island *isl, const doubl
 }
 
 /* 1 if a force other than gravity and contacts can do work on the island: thrusters, external force or
- * torque, springs. */
+ * torque, springs, the force callback (asked after the island's force evaluations, which record it). */
 static int island_driven(const island_ctx *c)
 {
     const lc_world *w = c->w;
@@ -705,10 +705,10 @@ static int finish(island_ctx *c, lc_touch *end, int nend, const lc_touch *t, con
     return 0;
 }
 
-/* Steps 1-6 over dt from the island's current state. Returns 0, -1 without memory, or -3 (see
- * lc_contact_advance); on 0 the touches at the end are in cr->b_end (*nend), the last flow's touches
- * and rows in cr->b_touch and cr->b_rows (*nt, *h_last). */
-static int advance(island_ctx *c, double dt, int driven, double e0, double size0, int *nend, int *nt, double *h_last)
+/* Steps 1-6 over dt from the island's current state. Returns 0, -1 without memory or when the force
+ * callback failed, or -3 (see lc_contact_advance); on 0 the touches at the end are in cr->b_end (*nend),
+ * the last flow's touches and rows in cr->b_touch and cr->b_rows (*nt, *h_last). */
+static int advance(island_ctx *c, double dt, double e0, double size0, int *nend, int *nt, double *h_last)
 {
     lc_world *w = c->w;
     lc_contact_regime *cr = c->cr;
@@ -751,7 +751,7 @@ static int advance(island_ctx *c, double dt, int driven, double e0, double size0
     /* bodies the projection cannot separate (wedged deep into a corner within one step), or an energy
      * gain the island's kinetic energy cannot pay for */
     c->overlap = overlap;
-    c->unpaid = driven ? 0.0 : energy_guard(c, e0, size0);
+    c->unpaid = island_driven(c) ? 0.0 : energy_guard(c, e0, size0);
     if (overlap > LC_CONTACT_OVERLAP_LEFT || c->unpaid > LC_CONTACT_ENERGY_LEFT * size0) return -3;
     return 0;
 }
@@ -760,7 +760,7 @@ int lc_contact_advance(lc_world *w, lc_contact_regime *cr, const lc_island *isl,
 {
     island_ctx c;
     double e0 = 0.0, ke0 = 0.0, size0 = 0.0, h = dt;
-    int i, k, nt = 0, nend = 0, driven, status, ncontacts = w->contact_count, nevents = lc_events_staged(w->events);
+    int i, k, nt = 0, nend = 0, status, ncontacts = w->contact_count, nevents = lc_events_staged(w->events);
     double *start;
     memset(&c, 0, sizeof c);
     c.w = w;
@@ -776,9 +776,8 @@ int lc_contact_advance(lc_world *w, lc_contact_regime *cr, const lc_island *isl,
         memcpy(&start[i * 6], &w->state[isl->rows[i] * 6], 6 * sizeof(double));
         w->rests_dissipative[isl->rows[i]] = 0;
     }
-    driven = island_driven(&c);
     e0 = island_energy(w, isl, start, 0, &ke0, &size0);
-    status = advance(&c, dt, driven, e0, size0, &nend, &nt, &h);
+    status = advance(&c, dt, e0, size0, &nend, &nt, &h);
     if (status == -3) {
         /* once more with every solve run to convergence (solve()): a nearly resting island whose solve
          * stopped at contact_iterations can end overlapping or with a gain its kinetic energy cannot pay */
@@ -787,7 +786,7 @@ int lc_contact_advance(lc_world *w, lc_contact_regime *cr, const lc_island *isl,
         w->contact_count = ncontacts;
         lc_events_unstage(w->events, nevents);
         c.precise = 1;
-        status = advance(&c, dt, driven, e0, size0, &nend, &nt, &h);
+        status = advance(&c, dt, e0, size0, &nend, &nt, &h);
     }
     if (status == -3 && isl->nrows > LC_CONTACT_EVENT_FALLBACK_BODIES) {
         w->last.contact_unresolved++;

@@ -28,8 +28,9 @@ void lc_contact_regime_save(const lc_contact_regime *cr, const struct lc_world *
 int lc_contact_regime_load(lc_contact_regime *cr, const struct lc_world *w, struct lc_reader *in);
 
 /* Advances the island's bodies (w->state rows) by dt. Its impacts and the resting contacts at its
- * end go to the world's contacts, its work to w->last. Returns 0, -1 without memory, -2 when the
- * island's state became non-finite (the caller undoes the step), or -3 when an island of at most
+ * end go to the world's contacts, its work to w->last. Returns 0, -1 without memory or when the force
+ * callback failed (lc_force_callback_failure), -2 when the island's state became non-finite (the
+ * caller undoes the step), or -3 when an island of at most
  * LC_CONTACT_EVENT_FALLBACK_BODIES bodies ends, even with converged solves, with bodies overlapping
  * that the projection cannot separate or, without driving forces, with more energy than it began with
  * that its kinetic energy cannot pay for (the caller takes the step again with the island in the event

@@ -1,5 +1,6 @@
-/* Energy split as on the seed's bar graph (translational, rotational, gravitational, spring) and momentum
- * (lc_world_get_energy), and the energy balances that tell a step which has blown up. */
+/* Energy split as on the seed's bar graph (translational, rotational, gravitational, spring), the force
+ * callback's potential, and momentum (lc_world_get_energy), and the energy balances that tell a step
+ * which has blown up. */
 #include <math.h>
 #include "world.h"
 
@@ -26,14 +27,21 @@ void lc_compute_energy(const lc_world *w, const double *state, lc_energy *out)
         out->angular_momentum += m * (s[SX] * s[SVY] - s[SY] * s[SVX]) + I * s[SW];
     }
     out->spring = lc_spring_energy(w, state);
+    out->callback = 0.0;
     out->total = out->translational + out->rotational + out->gravitational + out->spring;
 }
 
+/* The step's balances above leave the callback's potential out (its work is bounded like an external
+ * force's, from the largest force it gave); the caller's reading includes it. */
 lc_status lc_world_get_energy(const lc_world *w, lc_energy *out)
 {
+    lc_energy e;
     if (w == NULL) return LC_ERR_NULL;
     if (out == NULL) return lc_fail((lc_world *)w, LC_ERR_NULL, "out is NULL");
-    lc_compute_energy(w, w->state, out);
+    lc_compute_energy(w, w->state, &e);
+    LC_TRY(lc_force_callback_potential(w, w->state, &e.callback));
+    e.total += e.callback;
+    *out = e;
     return LC_OK;
 }
 
@@ -71,16 +79,17 @@ int lc_contact_energy_blew_up(const lc_world *w, const double *s0, const double 
 }
 
 /* Impacts (e <= 1), contact forces, damping and springs (their energy counted) take energy out or keep
- * it; only external forces, torques and thrusters put it in, at most |F| |v| dt. A step that ends with
- * more energy than it started with, beyond 1 J + 1e-3 of it plus ten times that bound on the driving
- * forces' work (with |v| the larger of the body's speeds at the step's two ends, and the |F|^2 dt^2 / m
- * a force adds from rest), has blown up: a 1e-12 m, 10 kg polygon at 1e6 m/s pushed by an external
- * force in a 12 m box went to 5.7e21 m/s within one 22 ms step and left the box (regression input
+ * it; only external forces, torques, thrusters and the force callback (its largest force in the step)
+ * put it in, at most |F| |v| dt. A step that ends with more energy than it started with, beyond 1 J +
+ * 1e-3 of it plus ten times that bound on the driving forces' work (with |v| the larger of the body's
+ * speeds at the step's two ends, and the |F|^2 dt^2 / m a force adds from rest), has blown up: a
+ * 1e-12 m, 10 kg polygon at 1e6 m/s pushed by an external force in a 12 m box went to 5.7e21 m/s
+ * within one 22 ms step and left the box (regression input
  * fuzz/corpus/step-regressions/energy-pushed-1e-12m-polygon-1e6ms-leaves-box; no single trial
- * interval doubled its energy, which the per-interval check above looks for). A real
- * driving force's work grows with the speed, the blow-up's energy with its square. Measured before
- * the end-of-step projection, which may lift overlapping bodies against gravity; a step that starts
- * with bodies deep in each other is left to the projection. */
+ * interval doubled its energy, which the per-interval check above looks for). A real driving force's
+ * work grows with the speed, the blow-up's energy with its square. Measured before the end-of-step
+ * projection, which may lift overlapping bodies against gravity; a step that starts with bodies deep
+ * in each other is left to the projection. */
 int lc_step_energy_blew_up(const lc_world *w, const double *backup, double dt, int started_deep)
 {
     lc_energy e0, e1;
@@ -93,8 +102,9 @@ int lc_step_energy_blew_up(const lc_world *w, const double *backup, double dt, i
         const double *a = &backup[i * 6], *b = &w->state[i * 6];
         double f, tau, v, om;
         if (w->is_static[i]) continue;
-        f = sqrt(lc_dot(w->ext_force[i], w->ext_force[i]));
-        tau = fabs(w->ext_torque[i]);
+        lc_force_callback_peak(w, i, &f, &tau);
+        f += sqrt(lc_dot(w->ext_force[i], w->ext_force[i]));
+        tau += fabs(w->ext_torque[i]);
         for (k = 0; k < w->thruster_count[i]; ++k) {
             const lc_thruster *t = &w->thrusters[i][k];
             double thrust = fabs(t->magnitude * t->level);

@@ -241,8 +241,8 @@ int lc_event_crossings_find(lc_world *w, lc_event_crossings *ec, const lc_trial 
     nc = drop_stalled(ec, stalled, nstalled < LC_MAX_STALLED ? nstalled : LC_MAX_STALLED, nc);
     nc = drop_resting_drift(w, ec, tr->rest, tr->nrest, tr->s1, nc);
     if (nc < 0) return -1;
-    /* a body touching nothing and tied by no spring to another body moves on its own: its
-     * time-of-impact evaluations (and swept samples) need only the two bodies */
+    /* a body touching nothing and tied by no spring (nor force callback) to another body moves on its
+     * own: its time-of-impact evaluations (and swept samples) need only the two bodies */
     coupled = lc_buf_get(&ec->coupled, (size_t)w->count * sizeof(int));
     if (coupled == NULL) return -1;
     memset(coupled, 0, (size_t)w->count * sizeof(int));
@@ -252,6 +252,9 @@ int lc_event_crossings_find(lc_world *w, lc_event_crossings *ec, const lc_trial 
             coupled[lc_world_body_index(w, w->springs[i].def.body_a)] = 1;
             coupled[lc_world_body_index(w, w->springs[i].def.body_b)] = 1;
         }
+    /* the force callback may tie any body to any other */
+    if (lc_force_callback_on(w))
+        for (i = 0; i < w->count; ++i) coupled[i] = 1;
     for (i = nkept; i < nc; ++i) ((lc_crossing *)ec->cross.p)[i].t_hi = tr->h;
     nc = swept_check(w, ec, tr->s0, tr->s1, tr->h, pairs, np, nc, coupled, tr->rows, tr->nrows, tr->rest, tr->nrest);
     if (nc < 0) return -1;

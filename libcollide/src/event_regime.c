@@ -95,6 +95,8 @@ lc_status lc_event_advance(lc_world *w, lc_event_regime *er, const lc_step_try *
     memset(dirty, 0, (size_t)w->count);
     for (i = 0; i < w->spring_count; ++i)
         if (w->springs[i].def.body_b != LC_WORLD_ANCHOR) body_springs = 1;
+    /* the force callback may tie any body to any other, as a spring between bodies does */
+    if (lc_force_callback_on(w)) body_springs = 1;
 
     remaining = dt;
     while (remaining > 0.0) {

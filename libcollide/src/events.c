@@ -43,6 +43,7 @@ int lc_record_impact(lc_world *w, const lc_touch *t, lc_impact_kind kind)
     e->body_b = w->ids[t->b];
     e->point = t->p;
     e->normal = t->n;
+    e->gap = t->gap;
     e->normal_impulse = t->value;
     e->tangent_impulse = t->tangent;
     e->approach_speed = -t->vn_pre;

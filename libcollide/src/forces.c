@@ -1,4 +1,5 @@
-/* Applied forces: gravity, damping, thrusters, springs and external force/torque, as accelerations. */
+/* Applied forces: gravity, damping, thrusters, springs, external force/torque and the force callback
+ * (force_callback.c), as accelerations. */
 #include <math.h>
 #include "world.h"
 
@@ -34,19 +35,34 @@ static void spring_force(const lc_world *w, const double *state, const lc_spring
     *force_on_a = f;
 }
 
-void lc_applied_accelerations(const lc_world *w, const double *state, const int *rows, int n, double *acc)
+int lc_applied_accelerations(lc_world *w, const double *state, const int *rows, int n, double *acc)
 {
     int i, k;
     const lc_world_def *def = &w->def;
+    const double *user = NULL;
+    if (lc_force_callback_on(w) && lc_force_callback_eval(w, state, rows, n, &user) != 0) {
+        for (i = 0; i < n; ++i) acc[rows[i] * 3] = acc[rows[i] * 3 + 1] = acc[rows[i] * 3 + 2] = NAN;
+        return -1;
+    }
     for (i = 0; i < n; ++i) {
         int r = rows[i];
         const double *s = &state[r * 6];
         double m = w->mass[r], fx, fy, tq;
         double *a = &acc[r * 3];
         if (w->is_static[r]) { a[0] = a[1] = a[2] = 0.0; continue; }
-        fx = m * def->gravity.x + w->ext_force[r].x - def->damping * s[SVX];
-        fy = m * def->gravity.y + w->ext_force[r].y - def->damping * s[SVY];
-        tq = w->ext_torque[r] - def->damping * def->damping_rotation_ratio * s[SW];
+        fx = m * def->gravity.x + w->ext_force[r].x;
+        fy = m * def->gravity.y + w->ext_force[r].y;
+        tq = w->ext_torque[r];
+        /* the callback's force right after the external one: a callback force F on a body without one
+         * sums to the same bits as an external force F without a callback (x + 0 = x) */
+        if (user != NULL) {
+            fx += user[r * 3];
+            fy += user[r * 3 + 1];
+            tq += user[r * 3 + 2];
+        }
+        fx -= def->damping * s[SVX];
+        fy -= def->damping * s[SVY];
+        tq -= def->damping * def->damping_rotation_ratio * s[SW];
         if (w->thruster_count[r] > 0) {
             double c = cos(s[SA]), sn = sin(s[SA]);
             for (k = 0; k < w->thruster_count[r]; ++k) {
@@ -96,6 +112,7 @@ void lc_applied_accelerations(const lc_world *w, const double *state, const int 
         acc[r * 3 + 1] *= w->inv_mass[r];
         acc[r * 3 + 2] *= w->inv_inertia[r];
     }
+    return 0;
 }
 
 int lc_body_thrusting(const lc_world *w, int row)
@@ -108,15 +125,20 @@ int lc_body_thrusting(const lc_world *w, int row)
 
 int lc_body_driven(const lc_world *w, int row)
 {
-    return w->ext_force[row].x != 0.0 || w->ext_force[row].y != 0.0 || w->ext_torque[row] != 0.0 ||
-           lc_body_thrusting(w, row);
+    double f, tq;
+    if (w->ext_force[row].x != 0.0 || w->ext_force[row].y != 0.0 || w->ext_torque[row] != 0.0 ||
+        lc_body_thrusting(w, row))
+        return 1;
+    lc_force_callback_peak(w, row, &f, &tq);
+    return f != 0.0 || tq != 0.0;
 }
 
 int lc_body_forces_constant(const lc_world *w, int row)
 {
     int k;
     lc_body_id id = w->ids[row];
-    if (w->def.damping != 0.0 || lc_body_thrusting(w, row)) return 0;
+    /* the callback's force may change with any body's state */
+    if (w->def.damping != 0.0 || lc_body_thrusting(w, row) || lc_force_callback_on(w)) return 0;
     for (k = 0; k < w->spring_count; ++k)
         if (w->springs[k].def.body_a == id || w->springs[k].def.body_b == id) return 0;
     return 1;

@@ -29,7 +29,7 @@ static int derivative(lc_world *w, const double *s, const int *rows, int n, lc_t
                       double *acc, double *k)
 {
     int i;
-    lc_applied_accelerations(w, s, rows, n, acc);
+    if (lc_applied_accelerations(w, s, rows, n, acc) != 0) return -1;
     if (nt > 0 && lc_contact_forces(w, s, t, nt, acc) != 0) return -1;
     w->last.force_evaluations++;
     for (i = 0; i < n; ++i) {

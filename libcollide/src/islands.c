@@ -72,7 +72,7 @@ static int predict(lc_world *w, lc_islands *is, double dt, const uint8_t *frozen
     all = lc_buf_get(&is->b_all, (size_t)n * sizeof(int));
     if (!pred || !acc || !all) return -1;
     for (i = 0; i < n; ++i) all[i] = i;
-    lc_applied_accelerations(w, w->state, all, n, acc);
+    if (lc_applied_accelerations(w, w->state, all, n, acc) != 0) return -1;
     memcpy(pred, w->state, (size_t)n * 6 * sizeof(double));
     for (i = 0; i < n; ++i) {
         const double *s = &w->state[i * 6];

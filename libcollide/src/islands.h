@@ -30,7 +30,8 @@ void lc_islands_destroy(lc_islands *is);
 /* Builds the islands of w's current state for a step of dt. Bodies whose `frozen` entry is non-zero
  * (asleep; frozen may be NULL) are predicted not to move. `reach` (NULL, or 4 doubles per row: x0, y0,
  * x1, y1, empty when x0 > x1) adds to a body's swept box the region it is known to reach this step
- * (a retried step: where the first try took it). Returns 0, or -1 without memory. */
+ * (a retried step: where the first try took it). Returns 0, or -1 without memory or when the force
+ * callback failed. */
 int lc_islands_build(struct lc_world *w, lc_islands *is, double dt, const uint8_t *frozen, const double *reach);
 /* The swept boxes of the last build, 4 doubles per row (x0, y0, x1, y1). */
 const double *lc_islands_boxes(const lc_islands *is);

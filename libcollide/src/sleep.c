@@ -37,11 +37,14 @@ static void wake_all(lc_sleep *s)
     s->nkept = 0;
 }
 
+/* Sleep is on: allowed, and no force callback, whose force on a sleeping body no step would evaluate. */
+static int sleep_on(const lc_world *w) { return w->def.allow_sleep && !lc_force_callback_on(w); }
+
 int lc_sleep_begin_step(lc_sleep *s, lc_world *w)
 {
     const uint8_t *asleep;
     int i, dynamic = 0;
-    if (!w->def.allow_sleep) {
+    if (!sleep_on(w)) {
         if (s->any) wake_all(s);
         return 0;
     }
@@ -71,7 +74,7 @@ int lc_sleep_island(lc_sleep *s, lc_world *w, const lc_island *isl)
     uint8_t *asleep = (uint8_t *)s->b_asleep.p;
     double *rest = (double *)s->b_rest.p;
     int i, n = 0;
-    if (!w->def.allow_sleep || !s->any) return 0;
+    if (!sleep_on(w) || !s->any) return 0;
     for (i = 0; i < isl->nrows; ++i) n += asleep[isl->rows[i]];
     if (n == isl->nrows && n > 0) return 1;
     if (n == 0) return 0;
@@ -116,7 +119,7 @@ int lc_sleep_end_step(lc_sleep *s, lc_world *w, const lc_islands *is, double dt)
     double *rest = (double *)s->b_rest.p, v = w->def.sleep_speed;
     lc_contact *kept;
     int i, k, nk, reported, first_new;
-    if (!w->def.allow_sleep || w->count == 0) return 0;
+    if (!sleep_on(w) || w->count == 0) return 0;
     for (i = 0; i < w->count; ++i) {
         const double *st = &w->state[i * 6];
         if (w->is_static[i] || asleep[i]) continue;

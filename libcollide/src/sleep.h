@@ -1,6 +1,7 @@
 /* Sleep: an island at rest costs nothing (docs/contact_regime.md, "Sleep").
  *
- * With lc_world_def.allow_sleep, a dynamic body rests while its centre moves slower than sleep_speed
+ * With lc_world_def.allow_sleep and no force callback set (its force could reach a sleeping body, which
+ * no step evaluates), a dynamic body rests while its centre moves slower than sleep_speed
  * and its farthest point turns slower than that, no thruster or external force drives it and no spring
  * holds it. An island (islands.h) whose bodies have all rested for sleep_time falls asleep at the end of
  * a step: their velocities become exactly 0, the step stops advancing them, and their resting contacts
@@ -22,9 +23,9 @@ typedef struct lc_sleep lc_sleep;   /* owned by the world */
 lc_sleep *lc_sleep_create(void);
 void lc_sleep_destroy(lc_sleep *s);
 
-/* The start of a step: wakes every body if sleep is off or the world changed through the API since
- * the last step. Returns 1 when every dynamic body sleeps (nothing to advance), 0 otherwise, -1
- * without memory. */
+/* The start of a step: wakes every body if sleep is off (or a force callback is set) or the world
+ * changed through the API since the last step. Returns 1 when every dynamic body sleeps (nothing to
+ * advance), 0 otherwise, -1 without memory. */
 int lc_sleep_begin_step(lc_sleep *s, struct lc_world *w);
 /* Per row, 1 if the body sleeps (NULL when sleep is off or the world has no body). */
 const uint8_t *lc_sleep_asleep(const lc_sleep *s);

@@ -13,8 +13,9 @@
  * Not written, because a fresh one gives the same bits: scratch buffers, the per-body trig and box
  * caches (a hit returns the very bits a miss computes, world.h), the sort-and-sweep order (any start
  * sorts to the same order, broad_phase.c), the impact event stream (the caller's reading, not the
- * world's state) and the stage-timing setting. tests/c/test_snapshot.c continues every regime bit for
- * bit from a loaded snapshot, which is what shows that list complete.
+ * world's state), the stage-timing setting and the force callback (the caller's functions: a load keeps
+ * the world's own). tests/c/test_snapshot.c continues every regime bit for bit from a loaded snapshot,
+ * which is what shows that list complete.
  *
  * A load builds a new world from the snapshot and, only when all of it was read and checked, swaps it
  * in: a bad snapshot leaves the world as it was. */
@@ -467,15 +468,21 @@ lc_status lc_world_load(lc_world *w, const void *buf, size_t size)
     char why[256];
     lc_status st;
     lc_world *loaded, old;
+    struct lc_force_callback *fresh_callback;
     if (w == NULL) return LC_ERR_NULL;
     if (buf == NULL) return lc_fail(w, LC_ERR_NULL, "buf is NULL");
     loaded = from_snapshot(buf, size, &st, why, sizeof why);
     if (loaded == NULL) return lc_fail(w, st, "%s; the world is unchanged", why);
+    fresh_callback = loaded->force_callback;
     /* the loaded world's contents into w, w's old contents freed with the shell */
     old = *w;
     *w = *loaded;
     *loaded = old;
     w->stage_timing = loaded->stage_timing;
+    /* the force callback stays too: its functions are the caller's, not the world's state (the loaded
+     * world's fresh, empty one goes with the shell) */
+    w->force_callback = old.force_callback;
+    loaded->force_callback = fresh_callback;
     lc_world_destroy(loaded);
     w->error[0] = '\0';
     return LC_OK;

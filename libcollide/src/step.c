@@ -40,11 +40,16 @@ void lc_step_state_destroy(lc_step_state *ss)
  * that did not happen. */
 lc_status lc_step_undo(lc_world *w, const lc_step_try *step, lc_status s, const char *what)
 {
+    lc_status cs = LC_OK;
+    const char *why = lc_force_callback_failure(w, &cs);
     lc_stage_end(w, &w->last.time_step, w->step_t0);
     memcpy(w->state, step->start, (size_t)w->count * 6 * sizeof(double));
     w->time = step->time0;
     w->contact_count = 0;
     lc_events_unstage(w->events, 0);
+    /* a failed force callback is what stopped the step, whichever stage noticed it (its evaluations
+     * return as an allocation failure would, and their NaN accelerations may trip a finiteness check) */
+    if (why != NULL) return lc_fail(w, cs, "%s; the step was undone", why);
     return lc_fail(w, s, "%s; the step was undone", what);
 }
 
@@ -227,10 +232,11 @@ lc_status lc_world_step(lc_world *w, double dt)
     step.start = backup;
     step.time0 = time0;
     step.force_event = force_event;
-    /* what each body rests on picks its island's regime: searched again only if an API call changed
-     * the bodies since the last step marked them; the contact regime's kept forces become its warm
-     * start */
-    if (lc_regime_refresh(w) != 0 || lc_contact_regime_begin_step(w->contact) != 0)
+    /* the force callback forgets the last step's failure and peak forces; what each body rests on picks
+     * its island's regime: searched again only if an API call changed the bodies since the last step
+     * marked them; the contact regime's kept forces become its warm start */
+    if (lc_force_callback_begin_step(w) != 0 || lc_regime_refresh(w) != 0 ||
+        lc_contact_regime_begin_step(w->contact) != 0)
         return lc_step_undo(w, &step, LC_ERR_NO_MEMORY, "out of memory during the step");
     /* every body asleep: nothing moves, the sleeping contacts are reported again */
     i = lc_sleep_begin_step(w->sleep, w);
@@ -279,6 +285,9 @@ lc_status lc_world_step(lc_world *w, double dt)
         restart_step(w, backup, marks0, time0);
     }
     w->time = time0 + dt;
+    /* no stage may keep a step whose force callback failed (a time-of-impact search reads a failed
+     * evaluation as "no impact") */
+    if (lc_force_callback_failure(w, &st) != NULL) return lc_step_undo(w, &step, st, "the force callback failed");
     /* a non-finite state would poison every later step: refuse the step instead */
     for (i = 0; i < w->count * 6; ++i)
         if (!isfinite(w->state[i])) return lc_step_undo(w, &step, LC_ERR_NUMERIC, "the state became non-finite");

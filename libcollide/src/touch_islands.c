@@ -1,6 +1,7 @@
 /* The event regime's touch islands (finer than the step's islands of islands.c): bodies joined by
- * resting touches or by springs between bodies move together, and apart from every other touch island
- * (static bodies join nothing: they transmit no motion). A time-of-impact search needs only the islands
+ * resting touches or by springs between bodies (all of them while a force callback is set) move
+ * together, and apart from every other touch island (static bodies join nothing: they transmit no
+ * motion). A time-of-impact search needs only the islands
  * of the crossing's two bodies; integrating the whole world there made every evaluation in a settling
  * scene (20 blocks, each on the floor) solve all of their contact forces, ~2000 force evaluations per
  * step. Rows and touches are sorted by island, in their order. */
@@ -72,6 +73,9 @@ int lc_touch_islands_build(const lc_world *w, lc_touch_islands *is, const int *r
             int a = lc_world_body_index(w, w->springs[i].def.body_a), b = lc_world_body_index(w, w->springs[i].def.body_b);
             if (a >= 0 && b >= 0 && !w->is_static[a] && !w->is_static[b]) island_join(parent, a, b);
         }
+    /* the force callback may tie any body to any other: the bodies move together */
+    if (lc_force_callback_on(w))
+        for (i = 1; i < nrows; ++i) island_join(parent, rows[0], rows[i]);
     /* number the islands by their first row; is->of[root] holds the number while counting */
     is->count = 0;
     for (i = 0; i < nrows; ++i) {

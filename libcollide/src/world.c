@@ -67,6 +67,7 @@ const char *lc_status_string(lc_status status)
     case LC_ERR_NUMERIC: return "numerical failure";
     case LC_ERR_BAD_ENUM: return "unknown enum value";
     case LC_ERR_BAD_SNAPSHOT: return "bad snapshot";
+    case LC_ERR_CALLBACK: return "callback failed";
     }
     return "unknown status";
 }
@@ -220,10 +221,12 @@ lc_world *lc_world_create(const lc_world_def *def, char *errbuf, size_t errbuf_l
         w->sparse_lcp = lc_sparse_lcp_state_create();
         w->static_load = lc_static_load_state_create();
         w->sleep = lc_sleep_create();
+        w->force_callback = lc_force_callback_create();
         w->lcp = lc_lcp_workspace_create();
         w->events = lc_events_create(def->event_capacity);
-        if (!w->events || !w->step_state || !w->islands || !w->event || !w->contact || !w->broad_phase || !w->integrator ||
-            !w->contact_forces || !w->impulse || !w->sparse_lcp || !w->static_load || !w->sleep || !w->lcp)
+        if (!w->events || !w->step_state || !w->islands || !w->event || !w->contact || !w->broad_phase ||
+            !w->integrator || !w->contact_forces || !w->impulse || !w->sparse_lcp || !w->static_load || !w->sleep ||
+            !w->force_callback || !w->lcp)
             s = lc_fail(w, LC_ERR_NO_MEMORY, "out of memory");
     }
     if (s != LC_OK) {
@@ -256,6 +259,7 @@ void lc_world_destroy(lc_world *w)
     lc_sparse_lcp_state_destroy(w->sparse_lcp);
     lc_static_load_state_destroy(w->static_load);
     lc_sleep_destroy(w->sleep);
+    lc_force_callback_destroy(w->force_callback);
     lc_lcp_workspace_destroy(w->lcp);
     lc_events_destroy(w->events);
     lc_buf_free(&w->b_pairs);

@@ -114,6 +114,7 @@ struct lc_world {
     struct lc_static_load_state *static_load;       /* static_load.c */
     struct lc_sleep *sleep;                         /* sleep.c */
     struct lc_events *events;                       /* events.c: the impact event stream */
+    struct lc_force_callback *force_callback;       /* force_callback.c */
     /* the dense solver's workspace (lcp.c), shared by the dense solves of contact_forces.c, impulse.c and
      * event_projection.c: scratch that no solve holds past its return */
     lc_lcp_workspace *lcp;
@@ -210,14 +211,39 @@ static inline int lc_any_marked(const uint8_t *marked, const int *rows, int n)
 }
 
 /* ---- forces.c: accelerations from applied (non-contact) forces ---- */
-/* For rows[0..n): acc[row*3 + 0..2] = (ax, ay, alpha) from gravity, damping, thrusters, springs, external. */
-void lc_applied_accelerations(const lc_world *w, const double *state, const int *rows, int n, double *acc);
+/* For rows[0..n): acc[row*3 + 0..2] = (ax, ay, alpha) from gravity, damping, thrusters, springs, external
+ * force and the force callback. Returns 0, or -1 when the force callback failed in this step (the rows'
+ * accelerations are then NaN; lc_force_callback_failure says why). */
+int lc_applied_accelerations(lc_world *w, const double *state, const int *rows, int n, double *acc);
 /* 1 if a body's applied forces are constant over time (so it may be advanced in closed form). */
 int lc_body_forces_constant(const lc_world *w, int row);
 /* 1 if any of body `row`'s thrusters fires (level != 0). */
 int lc_body_thrusting(const lc_world *w, int row);
-/* 1 if something outside the contacts drives body `row`: an external force or torque, or a thruster. */
+/* 1 if something outside the contacts drives body `row`: an external force or torque, a thruster, or the
+ * force callback (a non-zero force or torque on it in the step in progress). */
 int lc_body_driven(const lc_world *w, int row);
+
+/* ---- force_callback.c: the user's force law (collide/force.h) ---- */
+typedef struct lc_force_callback lc_force_callback;
+lc_force_callback *lc_force_callback_create(void);
+void lc_force_callback_destroy(lc_force_callback *fc);
+/* 1 when a force callback is set. */
+int lc_force_callback_on(const lc_world *w);
+/* At the start of a step: forgets the last step's failure and the forces recorded per row. 0, or -1 without
+ * memory. */
+int lc_force_callback_begin_step(lc_world *w);
+/* Evaluates the callback at `state` for the dynamic rows among rows[0..n): *forces points at count x 3
+ * doubles (fx, fy, torque per row; only those rows are meaningful). Records the largest force and torque
+ * each row received in the step. Returns 0, or -1 when the callback failed now or earlier in the step. */
+int lc_force_callback_eval(lc_world *w, const double *state, const int *rows, int n, const double **forces);
+/* The largest |force| (N) and |torque| (N*m) the callback put on body `row` in the step in progress. */
+void lc_force_callback_peak(const lc_world *w, int row, double *force, double *torque);
+/* Why the step in progress cannot go on (the callback failed, or its buffers found no memory; *status
+ * gets LC_ERR_CALLBACK or LC_ERR_NO_MEMORY), or NULL. */
+const char *lc_force_callback_failure(const lc_world *w, lc_status *status);
+/* The callback's potential energy (J) at `state`, 0 without a potential. LC_OK, or LC_ERR_CALLBACK with
+ * the message recorded on w. */
+lc_status lc_force_callback_potential(const lc_world *w, const double *state, double *out);
 
 /* ---- narrow_phase.c ---- */
 /* Geometry of a vertex/edge touch at `state`; fills p, n, ra, rb, gap, vn. */
@@ -326,7 +352,8 @@ typedef struct lc_integrator_state lc_integrator_state;
 lc_integrator_state *lc_integrator_state_create(void);
 void lc_integrator_state_destroy(lc_integrator_state *is);
 /* Advances rows (dynamic bodies) from s0 by h into s1 with the world integrator, touches held as resting
- * contacts; the rows not listed are copied from s0. Returns 0 or -1. */
+ * contacts; the rows not listed are copied from s0. Returns 0, or -1 without memory or when the force
+ * callback failed. */
 int lc_integrate(lc_world *w, const double *s0, double h, const int *rows, int nrows,
                  lc_touch *touches, int ntouches, double *s1);
 /* lc_integrate writing only the listed rows of s1 (the others keep whatever s1 held): for callers that

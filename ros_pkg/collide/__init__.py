@@ -20,6 +20,7 @@ _EXPORTS = {
     "CONTACT_DTYPE": "_views", "COLLISION": "_views", "RESTING": "_views",
     "EVENT_DTYPE": "_views", "IMPACT_EVENT": "_views", "IMPACT_CONTACT": "_views",
     "RayHit": "query", "BodyDistance": "query",
+    "ForceQuery": "force",
 }
 __all__ = sorted(_EXPORTS) + ["version"]
 

@@ -5,11 +5,14 @@ from typing import Any
 
 from . import build_ffi
 
-try:
-    if not build_ffi.is_up_to_date():
-        build_ffi.ensure_built()
-except build_ffi.BuildError as _exc:  # pragma: no cover - depends on the machine state
-    raise ImportError(f"collide: cannot build the C extension: {_exc}") from _exc
+# In a source checkout the extension is built (or refreshed) against LIBCOLLIDE_BUILD_DIR's library;
+# an installed wheel carries both, side by side in this directory (the extension's RUNPATH is $ORIGIN).
+if build_ffi.in_source_checkout():
+    try:
+        if not build_ffi.is_up_to_date():
+            build_ffi.ensure_built()
+    except build_ffi.BuildError as _exc:  # pragma: no cover - depends on the machine state
+        raise ImportError(f"collide: cannot build the C extension: {_exc}") from _exc
 
 from ._collide_cffi import ffi, lib  # noqa: E402  (the build above must run first)
 

@@ -37,8 +37,8 @@ CONTACT_DTYPE = _struct_dtype("lc_contact", {
 
 EVENT_DTYPE = _struct_dtype("lc_impact_event", {
     "time": np.float64, "body_a": np.uint32, "body_b": np.uint32, "point": (np.float64, (2,)),
-    "normal": (np.float64, (2,)), "normal_impulse": np.float64, "tangent_impulse": np.float64,
-    "approach_speed": np.float64, "kind": np.dtype(f"i{ffi.sizeof('lc_impact_kind')}"),
+    "normal": (np.float64, (2,)), "gap": np.float64, "normal_impulse": np.float64,
+    "tangent_impulse": np.float64, "approach_speed": np.float64, "kind": np.dtype(f"i{ffi.sizeof('lc_impact_kind')}"),
 })
 
 

@@ -3,12 +3,17 @@
 The cdef is not hand-written: it is the output of the C preprocessor run on
 ``libcollide/include/collide/collide.h`` (system headers replaced by empty shims, since cffi
 already knows ``size_t``/``uint32_t``/...), plus one ``#define NAME ...`` line per integer
-constant the headers define, whose value cffi then reads from the compiler.
+constant the headers define, whose value cffi then reads from the compiler. The one hand-written
+part declares the ``extern "Python"`` functions the force callback calls (``EXTERN_PYTHON``).
 
 ``python -m collide.build_ffi`` is idempotent: it rebuilds only when the headers, this file, the
 Python ABI or the library directory changed (a fingerprint of those is embedded in the extension),
 so it is fast when up to date. Environment: ``LIBCOLLIDE_BUILD_DIR`` (as scripts/env.sh sets it;
 default ``<repo>/build``) holds ``libcollide.so``; ``CC`` picks the preprocessor (default ``cc``).
+
+This is the source checkout's way. A wheel (``pip install .``, pyproject.toml) compiles the same
+extension with CMake from the C source that ``--emit-c`` writes, and ships it with ``libcollide.so``
+inside the installed package, which then has nothing to build.
 """
 from __future__ import annotations
 
@@ -39,6 +44,12 @@ _MARK = "collide-cffi-fingerprint:"
 
 class BuildError(RuntimeError):
     """The extension could not be built (missing library, compiler failure, ...)."""
+
+
+def in_source_checkout() -> bool:
+    """True when this package is the one in a checkout's ros_pkg/ (next to the C headers); False for
+    an installed wheel, whose extension and library were built with it."""
+    return PACKAGE_DIR.parent.name == "ros_pkg" and HEADER.is_file()
 
 
 def build_dir() -> Path:
@@ -105,12 +116,21 @@ def generate_cdef() -> str:
     return "\n".join(sorted(consts) + lines) + "\n"
 
 
+# The C entry points of the binding's force callbacks (collide/force.py defines them with
+# @ffi.def_extern): cffi compiles them into the extension, so no libffi closure is made at run time.
+EXTERN_PYTHON = """
+extern "Python" int collide_force_callback(void *, const lc_force_query *, double *);
+extern "Python" int collide_potential_callback(void *, const lc_force_query *, double *);
+"""
+
+
 def make_ffibuilder():  # -> cffi.FFI (imported lazily so `import collide` needs no setuptools)
     import cffi
 
     lib_dir = build_dir()
     ffibuilder = cffi.FFI()
     ffibuilder.cdef(generate_cdef())
+    ffibuilder.cdef(EXTERN_PYTHON)
     rel = os.path.relpath(lib_dir, PACKAGE_DIR)
     # The fingerprint of what the extension was built from lives in the binary itself, so a check
     # never trusts a stamp that could belong to another build directory.
@@ -127,6 +147,20 @@ def make_ffibuilder():  # -> cffi.FFI (imported lazily so `import collide` needs
         extra_compile_args=["-ffp-contract=off"],
     )
     return ffibuilder
+
+
+def write_c_source(target: Path) -> Path:
+    """Write the extension's C source to target, for a build that compiles and links it itself (the
+    wheel's CMake, cmake/python_package.cmake); the file is rewritten only when its text changes."""
+    import cffi
+
+    ffibuilder = cffi.FFI()
+    ffibuilder.cdef(generate_cdef())
+    ffibuilder.cdef(EXTERN_PYTHON)
+    ffibuilder.set_source(MODULE_NAME, '#include "collide/collide.h"\n')
+    target.parent.mkdir(parents=True, exist_ok=True)
+    ffibuilder.emit_c_code(str(target))
+    return target
 
 
 @contextlib.contextmanager
@@ -180,11 +214,20 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m collide.build_ffi", description=__doc__.splitlines()[0])
     parser.add_argument("--force", action="store_true", help="rebuild even if up to date")
     parser.add_argument("--print-cdef", action="store_true", help="print the generated cdef and exit")
+    parser.add_argument("--emit-c", metavar="FILE", type=Path,
+                        help="write the extension's C source to FILE and exit (the wheel's CMake build)")
     parser.add_argument("-v", "--verbose", action="store_true")
     args = parser.parse_args(argv)
+    if not in_source_checkout():
+        print(f"collide.build_ffi: {PACKAGE_DIR} is an installed package: its extension was built with it "
+              "and there is nothing to build (this command works in a source checkout's ros_pkg/)", file=sys.stderr)
+        return 0 if extension_path().exists() and not (args.print_cdef or args.emit_c) else 1
     try:
         if args.print_cdef:
             sys.stdout.write(generate_cdef())
+            return 0
+        if args.emit_c:
+            print(f"collide.build_ffi: wrote {write_c_source(args.emit_c)}")
             return 0
         fresh = not args.force and is_up_to_date()
         path = ensure_built(force=args.force, verbose=args.verbose)

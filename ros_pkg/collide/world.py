@@ -15,7 +15,9 @@ from . import _convert as cv
 from ._ffi import CollideError, check, ffi, lib
 from ._views import COLLISION, CONTACT_DTYPE, EVENT_DTYPE, IMPACT_CONTACT, IMPACT_EVENT, RESTING, _view
 from .body import Body, BodyRef, Spring, Thruster, _Record, _vec
+from . import force as _force
 from . import query as _query
+from .force import ForceFn, PotentialFn
 from .query import BodyDistance, RayHit
 
 __all__ = ["World", "Body", "Thruster", "Spring", "Energy", "CollideError", "CONTACT_DTYPE",
@@ -85,6 +87,7 @@ class Energy:
     total: float
     linear_momentum: tuple[float, float]
     angular_momentum: float
+    callback: float = 0.0  # the force callback's potential (set_force_callback), included in total
 
 
 class World:
@@ -103,6 +106,7 @@ class World:
         self._springs: dict[str, int] = {}
         self._view = ffi.new("lc_state_view *")
         self._poly_cache: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None = None
+        self._force_law: _force._Law | None = None   # kept alive while C holds its handle
         if settings:
             self.configure(**settings)
 
@@ -142,7 +146,14 @@ class World:
         """Advance by `steps` steps of dt seconds each."""
         h = cv.real(dt, "dt")
         for _ in range(cv.integer(steps, "steps")):
-            check(self._w, lib.lc_world_step(self._w, h))
+            _force.check_call(self, lib.lc_world_step(self._w, h))
+
+    def set_force_callback(self, force: ForceFn | None, potential: PotentialFn | None = None) -> None:
+        """A custom force law (collide/force.py): force(query) -> (n, 3) array of fx, fy, torque per
+        body row, called at every force evaluation of a step; potential(query) -> its potential energy
+        (J), added to energy.total. force=None removes the law. An exception in either fails the step
+        (or the energy reading) with CollideError raised from it; a failed step is undone."""
+        _force.set_force_callback(self, force, potential)
 
     # ---- bodies --------------------------------------------------------------------------------
     def _check_new_names(self, names: Sequence[str | None]) -> None:
@@ -350,9 +361,9 @@ class World:
     @property
     def energy(self) -> Energy:
         e = ffi.new("lc_energy *")
-        check(self._w, lib.lc_world_get_energy(self._w, e))
+        _force.check_call(self, lib.lc_world_get_energy(self._w, e))
         return Energy(e.translational, e.rotational, e.gravitational, e.spring, e.total,
-                      _vec(e.linear_momentum), e.angular_momentum)
+                      _vec(e.linear_momentum), e.angular_momentum, e.callback)
 
     def set_stage_timing(self, on: bool) -> None:
         """Measure wall time per pipeline stage into the counters' time_* fields (s); off by default."""

@@ -25,10 +25,15 @@ SPECS: tuple[Spec, ...] = (
          read_only=True),
     Spec("gravity", 0.0, "Gravity magnitude g (m/s^2), applied as (0, -g); negative pulls upwards", -100.0, 100.0),
     Spec("elasticity", 1.0, "Elasticity (coefficient of restitution) of every body, applied at once", 0.0, 1.0),
-    Spec("damping", 0.0, "Linear damping k (N*s/m): force -k*v, torque -k*r*omega (r from the scene)", 0.0, 100.0),
-    Spec("green_mass", 1.0, "Mass (kg) of body 'block1' (the green block), applied at once", 0.001, 1000.0),
+    Spec("damping", 0.0, "Linear damping k (N*s/m): force -k*v, torque -k*r*omega (r from the scene). At most 10: "
+         "C integrates it with RK4, which is stable while k * time_step / mass < 2.78 (beyond it a moving "
+         "block's steps are undone); 10 * 0.01 / 0.1 = 1 at the range ends (docs/ros_interface.md)", 0.0, 10.0),
+    Spec("green_mass", 1.0, "Mass (kg) of body 'block1' (the green block), applied at once. At least 0.1 kg: a "
+         "1 g block1 under 1e4 N into a wall has steps undone at time_step 0.001 s, a 0.1 kg one takes 1e5 N "
+         "for 20 s (docs/ros_interface.md)", 0.1, 1000.0),
     Spec("blocks", 2, "Number of blocks in the default scene; applies on ~/reset", 1, 6),
-    Spec("time_step", 0.001, "Physics time step (s)", 1e-5, 0.1),
+    Spec("time_step", 0.001, "Physics time step (s). At most 0.01 s: at 0.1 s a 0.1 kg block1 under 1e5 N into "
+         "a wall has its steps undone, at 0.01 s it takes them (docs/ros_interface.md)", 1e-5, 0.01),
     Spec("real_time_factor", 1.0, "Simulated seconds per wall second; 0 = as fast as possible", 0.0, 100.0),
     Spec("state_rate", 100.0, "Rate (Hz of sim time) of bodies/poses, bodies/states, contacts, energy", 1.0, 10000.0),
     Spec("state_qos_depth", 100, "History depth (KEEP_LAST, reliable) of the publishers of bodies/poses, "
@@ -50,12 +55,16 @@ SPECS: tuple[Spec, ...] = (
     Spec("cmd_vel_body", "block1", "Body driven by cmd_vel"),
     Spec("cmd_vel_linear_gain", 5.0, "cmd_vel servo: force = m*gain*(v_cmd - v) (1/s)", 0.0, 1000.0),
     Spec("cmd_vel_angular_gain", 5.0, "cmd_vel servo: torque = I*gain*(w_cmd - w) (1/s)", 0.0, 1000.0),
-    Spec("cmd_vel_max_accel", 20.0, "cmd_vel servo: |force| <= m*max_accel (m/s^2), plus gravity compensation",
+    Spec("cmd_vel_max_accel", 20.0, "cmd_vel servo: |force| <= m*max_accel (m/s^2) and <= max_thrust, plus "
+         "gravity compensation",
          0.0, 10000.0),
-    Spec("cmd_vel_max_angular_accel", 40.0, "cmd_vel servo: |torque| <= I*max_angular_accel (rad/s^2)",
+    Spec("cmd_vel_max_angular_accel", 40.0, "cmd_vel servo: |torque| <= I*max_angular_accel (rad/s^2) and "
+         "<= max_thrust",
          0.0, 100000.0),
-    Spec("max_thrust", 1000.0, "Largest accepted thrust force (N) / torque (N*m); larger commands are rejected",
-         0.0, 1e9),
+    Spec("max_thrust", 1000.0, "Largest accepted thrust force (N) / torque (N*m), larger commands are rejected; also the most the "
+         "cmd_vel servo applies. "
+         "At most 1e4: into a wall, the lightest block1 (0.1 kg) at time_step 0.01 s takes 1e5 N and N*m held "
+         "for 20 s and goes through the wall at 1e6 (docs/ros_interface.md)", 0.0, 1e4),
     Spec("max_body_topics", 64, "Bodies (in row order) that get a <body>/thrust subscription", 0, 100000,
          read_only=True),
     Spec("start_paused", False, "Start paused (use ~/step or ~/pause)", read_only=True),

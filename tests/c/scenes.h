@@ -23,6 +23,8 @@
  *   sc_static_box_rotated(w, width, height, x, y, angle, e)        - add a static rectangle turned by angle
  *   sc_potential(w, gx, gy)            - gravitational energy -sum m g.p of the dynamic bodies (J, zero at
  *                                        the origin), computed here from the state view
+ *   sc_driven_blocks(d, seed, mouse, ids)  - walls, six seed blocks with random velocities, a spring,
+ *                                        thrusters firing (and a mouse spring): every stateful feature
  */
 #ifndef LC_TESTS_SCENES_H
 #define LC_TESTS_SCENES_H
@@ -333,6 +335,49 @@ static inline double sc_potential(const lc_world *w, double gx, double gy)
         u -= v.mass[i] * (gx * s[0] + gy * s[1]);
     }
     return u;
+}
+
+/* Walls (e 0.7) around six 1 m x 3 m blocks at e = 0.7 (block 0 2 kg, the others 1 kg) with positions,
+ * angles and velocities drawn from sc_rng seed, damping 0.05, a spring between blocks 1 and 2, block 0's
+ * thrusters 0 and 2 firing, and with mouse_spring a spring from block 3 to a fixed point: everything that
+ * carries state or branches (the determinism, snapshot and event tests' scene). d: the settings to start
+ * from; ids: the six blocks' ids, or NULL. NULL if the world could not be made. */
+static inline lc_world *sc_driven_blocks(lc_world_def d, uint64_t seed, int mouse_spring, lc_body_id *ids)
+{
+    lc_world *w;
+    lc_body_id b[6];
+    lc_spring_def sd = lc_default_spring_def();
+    lc_spring_id sid;
+    sc_rng rng;
+    int i;
+    rng.s = seed;
+    d.damping = 0.05;
+    w = sc_world(&d);
+    if (!w) return NULL;
+    lc_world_add_walls(w, -6.0, -6.0, 6.0, 6.0, 1.0, 0.7, NULL);
+    for (i = 0; i < 6; i++)
+        b[i] = sc_box(w, 1.0, 3.0, -5.0 + 2.0 * i, sc_uniform(&rng, -2.0, 2.0), sc_uniform(&rng, -0.2, 0.2),
+                      sc_uniform(&rng, -4.0, 4.0), sc_uniform(&rng, -4.0, 4.0), sc_uniform(&rng, -2.0, 2.0),
+                      i == 0 ? 2.0 : 1.0, 0.7);
+    sd.body_a = b[1];
+    sd.body_b = b[2];
+    sd.stiffness = 2.0;
+    sd.rest_length = 2.0;
+    CHECK(lc_world_add_spring(w, &sd, &sid) == LC_OK, "%s", "spring");
+    if (mouse_spring) {
+        sd.body_a = b[3];
+        sd.body_b = LC_WORLD_ANCHOR;
+        sd.point_a.x = 0.2;
+        sd.point_a.y = 1.0;
+        sd.point_b.x = 0.0;
+        sd.point_b.y = 3.0;
+        sd.rest_length = 0.0;
+        CHECK(lc_world_add_spring(w, &sd, &sid) == LC_OK, "%s", "mouse spring");
+    }
+    CHECK(lc_body_add_default_thrusters(w, b[0], 1.5, NULL) == LC_OK, "%s", "thrusters");
+    CHECK(lc_body_set_thruster_mask(w, b[0], 0x5u) == LC_OK, "%s", "thruster mask");
+    if (ids) memcpy(ids, b, sizeof b);
+    return w;
 }
 
 #endif /* LC_TESTS_SCENES_H */

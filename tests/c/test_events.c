@@ -43,6 +43,7 @@ static void poll_collisions(const lc_world *w, evlist *l)
         e.body_b = c[i].body_b;
         e.point = c[i].point;
         e.normal = c[i].normal;
+        e.gap = c[i].gap;
         e.normal_impulse = c[i].impulse;
         e.tangent_impulse = c[i].tangent_impulse;
         e.approach_speed = -c[i].normal_velocity;
@@ -71,7 +72,7 @@ static int same_event(const lc_impact_event *a, const lc_impact_event *b, int wi
 {
     return a->time == b->time && a->body_a == b->body_a && a->body_b == b->body_b && a->point.x == b->point.x &&
            a->point.y == b->point.y && a->normal.x == b->normal.x && a->normal.y == b->normal.y &&
-           a->normal_impulse == b->normal_impulse && a->tangent_impulse == b->tangent_impulse &&
+           a->gap == b->gap && a->normal_impulse == b->normal_impulse && a->tangent_impulse == b->tangent_impulse &&
            a->approach_speed == b->approach_speed && (!with_kind || a->kind == b->kind);
 }
 
@@ -88,35 +89,13 @@ static int same_lists(const evlist *a, const evlist *b, int with_kind, const cha
     return 1;
 }
 
-/* test_determinism's seed scene: walls and blocks at e = 0.7, random velocities, gravity, damping,
- * two springs, thrusters; its islands go through both regimes. */
+/* The driven seed blocks (scenes.h) without the mouse spring: walls and blocks at e = 0.7, random
+ * velocities, gravity, damping, a spring, thrusters; its islands go through both regimes. */
 static lc_world *seed_scene(int event_capacity)
 {
     lc_world_def d = lc_default_world_def();
-    lc_world *w;
-    lc_body_id b[6];
-    lc_spring_def sd = lc_default_spring_def();
-    lc_spring_id sid;
-    sc_rng rng;
-    int i;
-    rng.s = 7;
-    d.damping = 0.05;
     d.event_capacity = event_capacity;
-    w = sc_world(&d);
-    if (!w) return NULL;
-    lc_world_add_walls(w, -6.0, -6.0, 6.0, 6.0, 1.0, 0.7, NULL);
-    for (i = 0; i < 6; i++)
-        b[i] = sc_box(w, 1.0, 3.0, -5.0 + 2.0 * i, sc_uniform(&rng, -2.0, 2.0), sc_uniform(&rng, -0.2, 0.2),
-                      sc_uniform(&rng, -4.0, 4.0), sc_uniform(&rng, -4.0, 4.0), sc_uniform(&rng, -2.0, 2.0),
-                      i == 0 ? 2.0 : 1.0, 0.7);
-    sd.body_a = b[1];
-    sd.body_b = b[2];
-    sd.stiffness = 2.0;
-    sd.rest_length = 2.0;
-    CHECK(lc_world_add_spring(w, &sd, &sid) == LC_OK, "%s", "spring");
-    CHECK(lc_body_add_default_thrusters(w, b[0], 1.5, NULL) == LC_OK, "%s", "thrusters");
-    CHECK(lc_body_set_thruster_mask(w, b[0], 0x5u) == LC_OK, "%s", "thruster mask");
-    return w;
+    return sc_driven_blocks(d, 7, 0, NULL);
 }
 
 /* A pyramid of base 6 (e 0, friction 0.5) on a floor, and a box (e 0.3) dropped on it at 5 m/s: the

@@ -67,37 +67,10 @@ typedef lc_world *(*builder)(void);
 
 static lc_world *seed_scene(void)
 {
-    lc_world_def d = lc_default_world_def();
-    lc_world *w;
     lc_body_id b[6];
-    lc_spring_def sd = lc_default_spring_def();
-    lc_spring_id sid;
     lc_vec2 push;
-    sc_rng rng;
-    int i;
-    rng.s = 11;
-    d.damping = 0.05;
-    w = sc_world(&d);
+    lc_world *w = sc_driven_blocks(lc_default_world_def(), 11, 1, b);
     if (!w) return NULL;
-    lc_world_add_walls(w, -6.0, -6.0, 6.0, 6.0, 1.0, 0.7, NULL);
-    for (i = 0; i < 6; i++)
-        b[i] = sc_box(w, 1.0, 3.0, -5.0 + 2.0 * i, sc_uniform(&rng, -2.0, 2.0), sc_uniform(&rng, -0.2, 0.2),
-                      sc_uniform(&rng, -4.0, 4.0), sc_uniform(&rng, -4.0, 4.0), sc_uniform(&rng, -2.0, 2.0),
-                      i == 0 ? 2.0 : 1.0, 0.7);
-    sd.body_a = b[1];
-    sd.body_b = b[2];
-    sd.stiffness = 2.0;
-    sd.rest_length = 2.0;
-    CHECK(lc_world_add_spring(w, &sd, &sid) == LC_OK, "%s", "spring");
-    sd.body_a = b[3];
-    sd.body_b = LC_WORLD_ANCHOR;
-    sd.point_a.x = 0.2;
-    sd.point_a.y = 1.0;
-    sd.point_b.y = 3.0;
-    sd.rest_length = 0.0;
-    CHECK(lc_world_add_spring(w, &sd, &sid) == LC_OK, "%s", "mouse spring");
-    CHECK(lc_body_add_default_thrusters(w, b[0], 1.5, NULL) == LC_OK, "%s", "thrusters");
-    CHECK(lc_body_set_thruster_mask(w, b[0], 0x5u) == LC_OK, "%s", "thruster mask");
     push.x = 0.3;
     push.y = 0.0;
     CHECK(lc_body_set_external(w, b[5], push, 0.05) == LC_OK, "%s", "external force");

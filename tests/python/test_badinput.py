@@ -159,9 +159,20 @@ def sim() -> Iterator[SimClient]:
 
 
 def at_rest(sim: SimClient, names: tuple[str, ...] = ("block1", "block2")) -> bool:
-    msg = sim.fresh("bodies/states", timeout=2.0)
-    if msg is None or tuple(msg.names) != names:
+    # a states message with these bodies: one published before a kill or spawn was answered can still
+    # be on its way with the old body set
+    got: list[Any] = []
+
+    def has_names() -> bool:
+        msg = sim.fresh("bodies/states", timeout=2.0)
+        if msg is None or tuple(msg.names) != names:
+            return False
+        got.append(msg)
+        return True
+
+    if not sim.wait_for(has_names, 15.0):
         return False
+    msg = got[-1]
     for i, n in enumerate(msg.names):
         p, t = msg.poses[i].position, msg.twists[i]
         if (p.x, p.y) != START.get(n, (p.x, p.y)) or (t.linear.x, t.linear.y, t.angular.z) != (0.0, 0.0, 0.0):

@@ -1,11 +1,11 @@
 """docs/c_api.md against the public headers, so the reference cannot drift from the API.
 
 The public API is what libcollide/include/collide/*.h declare: every function marked LC_API, every
-typedef'd struct with its fields, every enum with its values, and the LC_ macros (with those of the
-generated collide/version.h, from cmake/version.h.in). The page must have, for each function, a
-heading "### `name`" whose first C block is the header's declaration (compared token by token, so
-only layout may differ); for each struct a "### `name`" section whose table lists exactly its
-fields; every enum value; and no lc_/LC_ name that no header declares.
+typedef'd struct with its fields, every enum with its values, the function pointer types, and the LC_
+macros (with those of the generated collide/version.h, from cmake/version.h.in). The page must have,
+for each function, a heading "### `name`" whose first C block is the header's declaration (compared
+token by token, so only layout may differ); for each struct a "### `name`" section whose table lists
+exactly its fields; every enum value; and no lc_/LC_ name that no header declares.
 
 The control tests change the page in one place each and check that the checker reports it, so a
 parser that silently finds nothing cannot pass for an up-to-date page.
@@ -62,6 +62,7 @@ def read_api() -> Api:
             api.enums[m.group(2)] = re.findall(r"\b(LC_[A-Z0-9_]+)\s*=", m.group(1))
         api.types |= set(re.findall(r"\}\s*(lc_\w+)\s*;", code))
         api.types |= set(re.findall(r"typedef\s+[^;{}]*?\b(lc_\w+)\s*;", code))
+        api.types |= set(re.findall(r"typedef\s+[^;{}]*?\(\s*\*\s*(lc_\w+)\s*\)", code))  # function pointers
     api.macros |= set(re.findall(r"\bLC_[A-Z0-9_]+\b", VERSION_TEMPLATE.read_text()))
     return api
 
@@ -123,8 +124,8 @@ def test_headers_are_read() -> None:
     assert api.structs["lc_vec2"] == ["x", "y"]
     assert "sleep_speed" in api.structs["lc_world_def"] and "center_of_mass" in api.structs["lc_body_def"]
     assert "time_contact_regime" in api.structs["lc_counters"]
-    assert api.enums["lc_status"][-1] == "LC_ERR_BAD_SNAPSHOT"
-    assert {"lc_world", "lc_body_id", "lc_spring_id", "lc_status"} <= api.types
+    assert api.enums["lc_status"][-1] == "LC_ERR_CALLBACK"
+    assert {"lc_world", "lc_body_id", "lc_spring_id", "lc_status", "lc_force_fn", "lc_potential_fn"} <= api.types
     assert {"LC_API", "LC_WORLD_ANCHOR", "LC_VERSION_STRING"} <= api.macros
 
 

@@ -30,14 +30,14 @@ def polled_collisions(w: World) -> np.ndarray:
     c = w.contacts
     hits = c[c["kind"] == collide.COLLISION]
     out = np.zeros(len(hits), dtype=collide.EVENT_DTYPE)
-    for name in ("time", "body_a", "body_b", "point", "normal", "tangent_impulse"):
+    for name in ("time", "body_a", "body_b", "point", "normal", "gap", "tangent_impulse"):
         out[name] = hits[name]
     out["normal_impulse"] = hits["impulse"]
     out["approach_speed"] = -hits["normal_velocity"]
     return out
 
 
-FIELDS = ("time", "body_a", "body_b", "point", "normal", "normal_impulse", "tangent_impulse", "approach_speed")
+FIELDS = ("time", "body_a", "body_b", "point", "normal", "gap", "normal_impulse", "tangent_impulse", "approach_speed")
 
 
 def assert_same(a: np.ndarray, b: np.ndarray) -> None:

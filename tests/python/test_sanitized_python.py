@@ -28,9 +28,11 @@ SAN_DIR = ROOT / "build" / "sanitizer-python"
 GENERATED_INCLUDE = Path(os.environ.get("LIBCOLLIDE_BUILD_DIR") or ROOT / "build") / "include"
 SAN_FLAGS = ["-std=c99", "-O1", "-g", "-fPIC", "-ffp-contract=off", "-fno-omit-frame-pointer",
              "-fsanitize=address,undefined", "-fno-sanitize-recover=all"]
-# the tests run under the sanitizers: the binding's own suites and two node tests (spawn errors go
-# through the C library's validation and messages in a separate node process)
+# the tests run under the sanitizers: the binding's own suites (the force callback's too: Python
+# called from inside a step) and two node tests (spawn errors go through the C library's validation
+# and messages in a separate node process)
 SUITES = ["tests/python/test_binding.py", "tests/python/test_binding_physics.py",
+          "tests/python/test_force_callback.py",
           "tests/python/test_node.py::test_spawn_bad_numbers_get_the_c_message",
           "tests/python/test_node.py::test_spawn_rejects_bad_shapes_and_overlap"]
 

@@ -10,6 +10,7 @@
 #include "collide/math.h"
 #include "collide/types.h"
 #include "collide/query.h"   /* queries: bodies at a point or in a box, ray casts, distance of two bodies */
+#include "collide/force.h"   /* a custom force law as a callback */
 
 #ifdef __cplusplus
 extern "C" {

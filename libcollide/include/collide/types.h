@@ -35,7 +35,8 @@ typedef enum lc_status {
     LC_ERR_NO_MEMORY = 9,       /* allocation failed */
     LC_ERR_NUMERIC = 10,        /* a step produced a non-finite state; the step was undone */
     LC_ERR_BAD_ENUM = 11,       /* an enum field holds an unknown value */
-    LC_ERR_BAD_SNAPSHOT = 12    /* a snapshot (lc_world_load) that is truncated, corrupt or of another format */
+    LC_ERR_BAD_SNAPSHOT = 12,   /* a snapshot (lc_world_load) that is truncated, corrupt or of another format */
+    LC_ERR_CALLBACK = 13        /* a user callback failed or gave a non-finite value (a step: undone) */
 } lc_status;
 
 /* Free-flight integrator; the value is its order of accuracy. */
@@ -222,6 +223,7 @@ typedef struct lc_impact_event {
     lc_body_id body_b;
     lc_vec2 point;            /* m, world */
     lc_vec2 normal;           /* unit, world */
+    double gap;               /* m, separation along the normal when the impulse was applied */
     double normal_impulse;    /* N*s, along the normal, >= 0 */
     double tangent_impulse;   /* N*s, friction, along (-normal.y, normal.x) */
     double approach_speed;    /* m/s, the points' approach along the normal before the impact (minus the
@@ -230,12 +232,14 @@ typedef struct lc_impact_event {
     lc_impact_kind kind;
 } lc_impact_event;
 
-/* Energy split into translational, rotational, gravitational and spring parts, plus momentum. */
+/* Energy split into translational, rotational, gravitational, spring and force-callback parts, plus
+ * momentum. */
 typedef struct lc_energy {
     double translational;    /* J, sum of m|v|^2/2 */
     double rotational;       /* J, sum of I*omega^2/2 */
     double gravitational;    /* J, sum of m*g*(height above zero_energy_level) along -gravity */
     double spring;           /* J, sum of k*stretch^2/2 */
+    double callback;         /* J, the force callback's potential (lc_potential_fn); 0 without one */
     double total;            /* J */
     lc_vec2 linear_momentum; /* kg*m/s */
     double angular_momentum; /* kg*m^2/s, about the world origin */

@@ -1,6 +1,7 @@
 """The commands in force turned into the external force and torque of each body for the coming step:
 expired commands dropped (command_timeout), body-frame thrust turned into the world frame, and the
-cmd_vel servo (a velocity error times a gain, bounded, plus gravity compensation)."""
+cmd_vel servo (a velocity error times a gain, bounded by an acceleration and by max_thrust, plus
+gravity compensation)."""
 from __future__ import annotations
 
 import math
@@ -11,30 +12,34 @@ import numpy as np
 
 @dataclass(frozen=True)
 class ServoGains:
-    """The cmd_vel servo's parameters (docs/ros_interface.md, cmd_vel_*), and gravity g (m/s^2)."""
+    """The cmd_vel servo's parameters (docs/ros_interface.md, cmd_vel_*), max_thrust and gravity g."""
 
     linear: float          # 1/s
     angular: float         # 1/s
     max_accel: float       # m/s^2
     max_angular_accel: float  # rad/s^2
-    gravity: float
+    max_thrust: float      # N and N*m: the servo pushes no harder than a thrust command may
+    gravity: float         # m/s^2
 
 
 def servo_wrench(x: np.ndarray, mass: float, inertia: float, cmd: tuple[float, float, float],
                  g: ServoGains) -> tuple[float, float, float]:
     """Force (world frame) and torque that drive a body with state row ``x`` (x, y, angle, vx, vy, w)
     towards the body-frame velocity ``cmd`` = (vx, vy, wz): force = m*gain*(v_cmd - v) with
-    |force| <= m*max_accel, plus m*g upwards; torque = I*gain*(w_cmd - w) within +-I*max_angular_accel."""
+    |force| <= min(m*max_accel, max_thrust), plus m*g upwards; torque = I*gain*(w_cmd - w) within
+    +-min(I*max_angular_accel, max_thrust). Without the max_thrust bound a heavy body's servo would push
+    harder than the engine takes: 1000 kg at 1e4 m/s^2 is 1e7 N, which squeezes a 1 kg block through
+    a wall (docs/ros_interface.md, "What the ranges guarantee")."""
     ca, sa = math.cos(x[2]), math.sin(x[2])
     vdx, vdy = ca * cmd[0] - sa * cmd[1], sa * cmd[0] + ca * cmd[1]  # body-frame command -> world
     fx, fy = mass * g.linear * (vdx - x[3]), mass * g.linear * (vdy - x[4])
-    fmax = mass * g.max_accel
+    fmax = min(mass * g.max_accel, g.max_thrust)
     fn = math.hypot(fx, fy)
     if fn > fmax:
         fx, fy = fx * fmax / fn, fy * fmax / fn
     fy += mass * g.gravity  # hold the body up against gravity while driven
     tau = inertia * g.angular * (cmd[2] - x[5])
-    tmax = inertia * g.max_angular_accel
+    tmax = min(inertia * g.max_angular_accel, g.max_thrust)
     tau = max(-tmax, min(tmax, tau))
     return fx, fy, tau
 
@@ -81,7 +86,7 @@ class Forces:
             p = self._p
             gains = ServoGains(float(p["cmd_vel_linear_gain"]), float(p["cmd_vel_angular_gain"]),
                                float(p["cmd_vel_max_accel"]), float(p["cmd_vel_max_angular_accel"]),
-                               float(p["gravity"]))
+                               float(p["max_thrust"]), float(p["gravity"]))
             fx, fy, tau = servo_wrench(st[r], self._masses[r], self._inertias[r], (cv.vx, cv.vy, cv.wz), gains)
             acc = total.setdefault(name, [0.0, 0.0, 0.0])
             acc[0] += fx
