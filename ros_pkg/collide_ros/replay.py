@@ -110,6 +110,8 @@ def iter_states(bag: str | Path, store: Any) -> Iterator[tuple[int, bytes]]:
 
     with Reader(Path(bag)) as r:
         conns = [c for c in r.connections if _split_ns(c.topic, "bodies/states") is not None]
+        if not conns:
+            return  # Reader.messages(connections=[]) would yield every message of the bag
         for conn, _ts, raw in r.messages(connections=conns):
             yield _ns(store.deserialize_cdr(raw, conn.msgtype).header.stamp), bytes(raw)
 
@@ -121,6 +123,8 @@ def iter_commands(bag: str | Path, store: Any) -> Iterator[Command]:
     heap: list[tuple[int, int, Command]] = []
     with Reader(Path(bag)) as r:
         conns = [c for c in r.connections if c.topic.find("/" + APPLIED) >= 0]
+        if not conns:
+            return  # no command echoes recorded; messages(connections=[]) would yield them all
         for seq, (conn, _ts, raw) in enumerate(r.messages(connections=conns)):
             t = conn.topic
             rel = t[t.find("/" + APPLIED) + 1 + len(APPLIED):]
@@ -215,6 +219,9 @@ def replay(bag: str | Path, delay_command: int | None = None,
             on_start(snap)
         cap = _Capture()
         node._pub_states = cap
+        # the state at the snapshot itself: a recorded state of the snapshot's stamp (published by the
+        # step the snapshot was taken after) is compared with it, not stepped to
+        node._publish_state()
         dt = float(node._p["time_step"])
         stamped = bool(node._p["cmd_vel_stamped"])
         rejected0 = node.rejected

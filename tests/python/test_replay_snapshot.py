@@ -4,6 +4,7 @@ snapshot at its start, stepping only the recorded span; SIGTERM ends a replay wi
 from __future__ import annotations
 
 import json
+import os
 import signal
 import subprocess
 import sys
@@ -13,11 +14,18 @@ from typing import Iterator
 
 import pytest
 import rclpy
-from rosgraph_msgs.msg import Clock
+from rclpy.parameter import Parameter
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from rclpy.serialization import serialize_message
+from rosgraph_msgs.msg import Clock
 
+from collide_ros.cdr import split_time
 from collide_ros.demo import Proc
-from collide_ros.replay import replay, verdict
+from collide_ros.node import SimNode
+from collide_ros.recorder import SNAPSHOT_TYPE, make_typestore, msgdef_and_hash
+from collide_ros.replay import _Capture, replay, verdict
+
+STATES_TYPE = "libcollide_msgs/msg/BodyStates"
 
 GIVE_UP = 120.0  # s: guards against a hang only
 LONG_RUN = 20.0  # s of sim time the node runs before the recording starts
@@ -107,3 +115,46 @@ def test_sigterm_ends_the_replay_with_a_verdict(long_bag: Path, tmp_path: Path) 
     res = json.loads(next(ln for ln in p.lines if ln.startswith("{")))
     assert rc == 3 and res["stopped"] and res["first_mismatch_s"] is None, p.lines
     assert any(ln.startswith("replay: STOPPED by a signal") for ln in p.lines)
+
+
+def _write_bag(bag: Path, ns: str, snapshot: bytes, states: list[tuple[int, bytes]]) -> None:
+    """A bag of the snapshot, then the states, as the recorder writes them (receive order)."""
+    from rosbags.rosbag2 import StoragePlugin, Writer
+
+    store = make_typestore()
+    with Writer(bag, version=9, storage_plugin=StoragePlugin.MCAP) as w:
+        conns = {}
+        for topic, msgtype in ((f"{ns}/snapshot", SNAPSHOT_TYPE), (f"{ns}/bodies/states", STATES_TYPE)):
+            msgdef, rihs = msgdef_and_hash(store, msgtype)
+            conns[topic] = w.add_connection(topic, msgtype, msgdef=msgdef, rihs01=rihs)
+        w.write(conns[f"{ns}/snapshot"], 1, snapshot)
+        for i, (_stamp, raw) in enumerate(states):
+            w.write(conns[f"{ns}/bodies/states"], 2 + i, raw)
+
+
+def test_state_stamped_at_the_snapshot_is_compared(tmp_path: Path, ros: None) -> None:
+    """A snapshot taken right after a step that published a state has that state's stamp: the replay
+    compares the recorded state with the loaded snapshot's and steps on from there."""
+    ns = f"/stamp_{os.getpid()}"
+    node = SimNode(namespace=ns, parameter_overrides=[Parameter("start_paused", value=True)])
+    cap = _Capture()
+    node._pub_states = cap
+    states: list[tuple[int, bytes]] = []
+    snapshot = b""
+    try:
+        while len(states) < 10:
+            assert node.step_once()
+            if cap.count > len(states):
+                assert cap.last is not None
+                sec, nsec = split_time(node.sim_time)
+                states.append((sec * 1_000_000_000 + nsec, cap.last))
+                if len(states) == 4:  # the snapshot after the step that published the 4th state
+                    snapshot = bytes(serialize_message(node.snapshot_message()))
+    finally:
+        node.destroy_node()
+    _write_bag(tmp_path / "bag", ns, snapshot, states)
+    res = replay(tmp_path / "bag")
+    # 3 states before the snapshot; the 4th at its stamp, compared without a step; 6 stepped to
+    assert res["skipped"] == 3 and res["missing"] == 0, res
+    assert res["ok"] and res["compared"] == res["identical"] == 7, res
+    assert res["steps"] == round((states[-1][0] - states[3][0]) * 1e-9 / res["time_step"]), res
