@@ -13,8 +13,10 @@ from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPo
 from std_srvs.srv import Trigger
 
 from collide_ros import cdr
-from collide_ros.sim.commands import CmdVel, Thrust
+from collide_ros.sim.commands import APPLIED, CmdVel, Thrust
 
+#: besides the command echoes (applied/...), what a replay reads from a bag
+REPLAY_TOPICS = frozenset({"bodies/states"})
 SNAPSHOT_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=1, reliability=ReliabilityPolicy.RELIABLE,
                           durability=DurabilityPolicy.TRANSIENT_LOCAL)
 
@@ -40,6 +42,11 @@ class Snapshots:
             "springs": sorted(self._springs),
             "names": list(self.world.names),
             "ext_bodies": sorted(self._ext_bodies),
+            # the readers each writer a replay needs had matched when the snapshot was taken: a recorder
+            # takes the snapshot as its start only once these include its own (collide_ros.recorder)
+            "matched_readers": {p.pub.topic_name: p.pub.get_subscription_count()
+                                for k, p in sorted(self._published.items())
+                                if k in REPLAY_TOPICS or k.startswith(APPLIED)},
         }
 
     def snapshot_message(self) -> WorldSnapshot:
