@@ -367,9 +367,10 @@ def run(out: Path, duration: float, gif: bool, do_replay: bool, view: bool = Tru
             # every listed topic that has a publisher (ours included; no one publishes cmd_vel)
             wanted = {("/" + t).replace("//", "/") for t in topics if drv.node.count_publishers(t) > 0}
             got = {ln.split()[-1] for ln in rec.lines if ln.startswith("recorder: subscribed")}
-            # and the node's state saved at the start, so the replay starts before the first command
-            saved = any(ln.startswith("recorder: state saved on") for ln in rec.lines)
-            if wanted <= got and saved and drv.matched(2):
+            # and recording: every subscription matched and the node's state saved at the start, so the
+            # replay starts before the first command and every echo of one reaches the bag
+            recording = any(ln.startswith("recorder: recording") for ln in rec.lines)
+            if wanted <= got and recording and drv.matched(2):
                 break
             if time.monotonic() > end or rec.proc.poll() is not None:
                 raise RuntimeError(f"recorder did not subscribe to {sorted(wanted - got)}; "
