@@ -15,6 +15,7 @@ from typing import Callable, Iterator
 import pytest
 import rclpy
 from rclpy.parameter import Parameter
+from rclpy.parameter_client import AsyncParameterClient
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from rclpy.serialization import serialize_message
 from rosgraph_msgs.msg import Clock
@@ -41,9 +42,11 @@ def ros() -> Iterator[None]:
 
 
 def _record(tmp: Path, node_args: list[str], sim_seconds: float, wait_sim: float = 0.0) -> Path:
-    """Start a node, wait until its /clock reads `wait_sim` s, start the recorder with its defaults, and
-    once it says it is recording let the sim run `sim_seconds` s of sim time; stop both, return the bag.
-    Every wait is on a condition (a clock value, a line of the recorder), GIVE_UP only ends a hang."""
+    """Start a node, wait until its /clock reads `wait_sim` s, set it to real time (a recorder keeps up with
+    a node at real time, not with one flat out: what it has not taken when stopped is not in the bag),
+    start the recorder with its defaults, and once it says it is recording let the sim run `sim_seconds` s
+    of sim time; stop both, return the bag. Every wait is on a condition (a clock value, a parameter's
+    answer, a line of the recorder), GIVE_UP only ends a hang."""
     bag = tmp / "bag"
     node = Proc([sys.executable, "-m", "collide_ros.node", "--ros-args", *node_args], tmp / "node.log")
     watcher = rclpy.create_node("replay_test_clock")
@@ -62,6 +65,14 @@ def _record(tmp: Path, node_args: list[str], sim_seconds: float, wait_sim: float
             rclpy.spin_once(watcher, timeout_sec=0.05)
     try:
         wait(lambda: seen["t"] >= wait_sim, f"sim time {wait_sim} s")
+        params = AsyncParameterClient(watcher, "sim")
+        while True:  # a lost answer is asked again: setting the same value twice changes nothing
+            fut = params.set_parameters([Parameter("real_time_factor", value=1.0)])
+            rclpy.spin_until_future_complete(watcher, fut, timeout_sec=5.0)
+            if fut.done() and fut.result() is not None:
+                assert all(r.successful for r in fut.result().results), fut.result()
+                break
+            assert node.proc.poll() is None and time.monotonic() < end, f"no answer to set_parameters: {node.lines}"
         rec = Proc([sys.executable, "-m", "collide_ros.recorder", "--out", str(bag)], tmp / "recorder.log")
         wait(lambda: any(ln.startswith("recorder: recording") for ln in rec.lines), "the recorder's 'recording'")
         assert any(ln.startswith("recorder: state saved on /sim/snapshot") for ln in rec.lines), rec.lines
@@ -70,8 +81,8 @@ def _record(tmp: Path, node_args: list[str], sim_seconds: float, wait_sim: float
         assert rec.stop(timeout=GIVE_UP) == 0, rec.lines
         counts = _counts(rec.lines)
         # state_rate's default 100 Hz of sim time gives 100 states a recorded second, more from the 'recording'
-        # line to the clock message read after it; at least half of them: the python recorder may miss
-        # some at the node's full speed (its reader's queue), every one it has is compared by the replay
+        # line to the clock message read after it; at least half of them: a loaded recorder may not have
+        # taken the last ones when stopped (the replay compares every one it has)
         assert counts["/bodies/states"] >= 50 * sim_seconds and counts["/sim/snapshot"] >= 2, rec.lines
     finally:
         if rec is not None:
@@ -92,7 +103,7 @@ def _counts(lines: list[str]) -> dict[str, int]:
 
 @pytest.fixture(scope="module")
 def long_bag(tmp_path_factory: pytest.TempPathFactory, ros: None) -> Path:
-    # flat out (real_time_factor 0): 20 s of sim time before the recording, many more during it
+    # flat out (real_time_factor 0): 20 s of sim time before the recording; recorded at real time
     return _record(tmp_path_factory.mktemp("long"), ["-p", "real_time_factor:=0.0"], 2.0, wait_sim=LONG_RUN)
 
 
