@@ -271,7 +271,11 @@ class StateRequest:
     the start when every count reaches the subscriptions the graph shows (this recorder's included),
     so every message the node sends after it reaches the bag. Otherwise the recorder asks again. The
     service's answer is not waited for: an answer sent before the client's reader has matched is
-    dropped, so the snapshot message is the proof."""
+    dropped, so the snapshot message is the proof. A request can be dropped the same way: with no
+    snapshot RESEND_POLLS polls after a call, it calls again (a second snapshot does no harm)."""
+
+    PERIOD = 0.1  # s between polls
+    RESEND_POLLS = 10
 
     def __init__(self, rec: Recorder, topic: str) -> None:
         from std_srvs.srv import Trigger
@@ -282,17 +286,23 @@ class StateRequest:
         self.request = Trigger.Request()
         self.needed: list[str] | None = None  # absolute topics a replay needs, from the first snapshot
         self.sent = False   # a call is out and no snapshot arrived since
+        self.polls_since_call = 0
         self.done = False
         self.asked = 0      # calls made
         self.unmatched: list[str] = []  # the last snapshot's topics whose writer had not matched us
-        self.timer = rec.node.create_timer(0.1, self.poll)
+        self.timer = rec.node.create_timer(self.PERIOD, self.poll)
 
     def poll(self) -> None:
-        if self.done or self.sent or self.needed is None or self.rec.closed:
+        if self.done or self.needed is None or self.rec.closed:
             return
+        if self.sent:
+            self.polls_since_call += 1
+            if self.polls_since_call < self.RESEND_POLLS:
+                return
         if not all(self.rec.matched(t) for t in self.needed) or not self.client.service_is_ready():
             return
         self.sent = True
+        self.polls_since_call = 0
         self.asked += 1
         self.client.call_async(self.request)
 

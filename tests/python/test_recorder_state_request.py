@@ -2,7 +2,8 @@
 a ROS graph: a stand-in recorder and node play the graph and the ~/save_snapshot service, which never
 answers. The state counts as saved only from a snapshot that followed a call and shows the node's writers
 had matched every subscription the graph lists; the latched snapshot from before the call and a snapshot
-taken before the writers matched do not count, and the recorder calls again."""
+taken before the writers matched do not count, and the recorder calls again; so it does when a request is
+lost (no snapshot follows it)."""
 from __future__ import annotations
 
 import json
@@ -97,3 +98,16 @@ def test_a_subscription_the_writer_has_not_matched_holds_the_start() -> None:
     node.graph_subs[STATES] = 1  # the other subscriber left
     req.poll()
     assert req.on_message(snapshot({STATES: 1, ECHO: 1}))
+
+
+def test_a_lost_request_is_sent_again() -> None:
+    req, node, _ = make()
+    req.on_message(snapshot({STATES: 2, ECHO: 1}))
+    req.poll()
+    assert node.calls == 1
+    for _ in range(StateRequest.RESEND_POLLS - 1):
+        req.poll()
+    assert node.calls == 1  # waiting for the snapshot the call asked for
+    req.poll()
+    assert node.calls == 2  # none came: the request was lost, ask again
+    assert req.on_message(snapshot({STATES: 2, ECHO: 1})) and req.done
