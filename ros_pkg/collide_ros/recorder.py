@@ -14,7 +14,8 @@ not: once the recorder's readers of what a replay needs from that node have matc
 node for a fresh snapshot (StateRequest) and prints ``recorder: state saved on <topic>`` when one is
 in the bag that shows the node's writers had matched them too. It prints ``recorder: recording``
 when every subscription has matched its publishers and every such state is saved: from then on,
-every message the publishers send reaches the bag. --duration counts from that line. Stops on
+every message the publishers send is delivered to it (a recorder slower than them loses the oldest
+of its queue). --duration counts from that line. Stops on
 --duration, SIGINT or SIGTERM, then prints the message count per topic. The bag's metadata
 (metadata.yaml and the MCAP file's own copy) says ``ros_distro: jazzy``.
 """
