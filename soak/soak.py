@@ -107,6 +107,10 @@ def _env() -> dict[str, str]:
     return env
 
 
+#: the node's state the recorder always records: latched at its start, on its ~/save_snapshot call(s), per reset
+SNAPSHOT_TOPIC = "/sim/snapshot"
+
+
 def recorded_topics() -> list[str]:
     return (["/bodies/poses", "/bodies/states", "/energy", "/contacts", "/tf", "/clock",
              "/applied/thrusters", "/applied/spring", "/applied/cmd_vel"]

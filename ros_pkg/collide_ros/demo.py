@@ -13,7 +13,7 @@
    them), then a free coast with no forces;
 4. stops both, renders out/demo.gif from the bag and prints a summary: collisions,
    energy drift over the force-free coast, real-time factor, where the bag and GIF are.
-With --replay it also replays the bag into a fresh node and checks the poses bit for bit.
+With --replay it also replays the bag from the node's state at its start and checks the states bit for bit.
 While the node runs, the live view (python -m collide_ros.view) serves the sim on
 http://127.0.0.1:8080/ (or a free port when 8080 is taken); its URL is printed (--no-view: not started).
 """
@@ -367,7 +367,10 @@ def run(out: Path, duration: float, gif: bool, do_replay: bool, view: bool = Tru
             # every listed topic that has a publisher (ours included; no one publishes cmd_vel)
             wanted = {("/" + t).replace("//", "/") for t in topics if drv.node.count_publishers(t) > 0}
             got = {ln.split()[-1] for ln in rec.lines if ln.startswith("recorder: subscribed")}
-            if wanted <= got and drv.matched(2):
+            # and recording: every subscription matched and the node's state saved at the start, so the
+            # replay starts before the first command and every echo of one reaches the bag
+            recording = any(ln.startswith("recorder: recording") for ln in rec.lines)
+            if wanted <= got and recording and drv.matched(2):
                 break
             if time.monotonic() > end or rec.proc.poll() is not None:
                 raise RuntimeError(f"recorder did not subscribe to {sorted(wanted - got)}; "
@@ -418,8 +421,7 @@ def run(out: Path, duration: float, gif: bool, do_replay: bool, view: bool = Tru
         rclpy.init(args=[])
         lock = ros_domain.lock_unless_set()
         try:
-            with (out / "demo_replay_node.log").open("w") as log:
-                summ["replay"] = replay(bag, log=log)
+            summ["replay"] = replay(bag)
         finally:
             rclpy.try_shutdown()
             if lock is not None:
@@ -454,7 +456,7 @@ def print_summary(s: dict[str, Any], counts: str) -> None:
     if "replay" in s:
         r = s["replay"]
         print(f"replay:              {r['identical']}/{r['compared']} recorded states bit-identical "
-              f"in a fresh node ({'OK' if r['ok'] else 'MISMATCH'})")
+              f"replayed from the snapshot ({'OK' if r['ok'] else 'MISMATCH'})")
 
 
 def main(argv: list[str] | None = None) -> int:

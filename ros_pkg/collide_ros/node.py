@@ -31,6 +31,7 @@ from collide_ros.sim.publishing import MAX_CONTACTS_PER_MESSAGE, Publishing
 from collide_ros.sim.publishing import concat_rows as _concat_rows
 from collide_ros.sim.scanners import Scanners
 from collide_ros.sim.services import MAX_STEPS_PER_CALL, Services
+from collide_ros.sim.snapshots import Snapshots
 from collide_ros.sim.spawning import Spawning
 from collide_ros.sim.stepping import SPLIT_DEPTH, SPLIT_MAX_SOLVER_WORK_PER_BODY, SPLIT_MAX_WORK, Stepping
 from collide_ros.sim.topology import Topology
@@ -40,8 +41,8 @@ __all__ = ["SimNode", "main", "APPLIED", "CATCH_UP_LIMIT", "MAX_CMD_SPEED", "MAX
            "_concat_rows"]
 
 
-class SimNode(Loop, Stepping, Forces, Commands, Publishing, Scanners, Diagnostics, Services, Spawning, Parameters,
-              Topology, Guards, Node):
+class SimNode(Loop, Stepping, Forces, Commands, Publishing, Scanners, Diagnostics, Services, Snapshots, Spawning,
+              Parameters, Topology, Guards, Node):
     """The ``sim`` node. Construct after rclpy.init(); call run() to simulate until shutdown."""
 
     #: every accepted command is republished on applied/<topic> (docs/contracts.md, bit-exact replay)
@@ -60,12 +61,14 @@ class SimNode(Loop, Stepping, Forces, Commands, Publishing, Scanners, Diagnostic
         self._init_forces()
         self._init_commands()
         self._init_services()
+        self._init_snapshots()
         self._watch_parameters()
         self._init_stepping()
         self._init_loop()
         self._start_diagnostics_window()
         self._periods()
         self._on_topology(deleteall=True)
+        self._publish_snapshot()
         self.get_logger().info(
             f"sim ready: {len(self.world.names)} bodies ({', '.join(self._dyn_names[:8])}"
             f"{' ...' if len(self._dyn_names) > 8 else ''}), dt {self._p['time_step']} s, "

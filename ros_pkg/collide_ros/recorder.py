@@ -8,9 +8,16 @@ adapted to the publishers seen in the graph, as rosbag2 does: reliable only if e
 publisher is reliable, transient_local only if every publisher is. Message definitions and
 RIHS01 type hashes come from the installed interface packages (libcollide_msgs and our
 rebuilt tf2_msgs) and from rosbags' Jazzy typestore for the standard messages; the hash of
-our own types is checked against the hash rosidl generated. Stops on --duration, SIGINT or
-SIGTERM, then prints the message count per topic. The bag's metadata (metadata.yaml and the MCAP
-file's own copy) says ``ros_distro: jazzy``.
+our own types is checked against the hash rosidl generated. A node's ``~/snapshot``
+(libcollide_msgs/WorldSnapshot, the state a replay starts from) is always recorded, --topics or
+not: once the recorder's readers of what a replay needs from that node have matched, it asks the
+node for a fresh snapshot (StateRequest) and prints ``recorder: state saved on <topic>`` when one is
+in the bag that shows the node's writers had matched them too. It prints ``recorder: recording``
+when every subscription has matched its publishers and every such state is saved: from then on,
+every message the publishers send is delivered to it (a recorder slower than them loses the oldest
+of its queue). --duration counts from that line. Stops on
+--duration, SIGINT or SIGTERM, then prints the message count per topic. The bag's metadata
+(metadata.yaml and the MCAP file's own copy) says ``ros_distro: jazzy``.
 """
 from __future__ import annotations
 
@@ -30,6 +37,10 @@ from typing import Any, Iterable
 EXCLUDED = frozenset({"/rosout", "/parameter_events"})
 OWN_PACKAGES = ("libcollide_msgs", "tf2_msgs")
 COMMAND_TOPICS = ("thrusters", "spring", "cmd_vel")  # plus every "<body>/thrust"
+#: always recorded, --topics or not: the sim's state a replay starts from. On subscribing, the recorder
+#: calls the node's save service (the topic's sibling), so the bag holds the state at its start.
+SNAPSHOT_TYPE = "libcollide_msgs/msg/WorldSnapshot"
+SAVE_SERVICE = "save_snapshot"
 #: the bag's ros_distro (metadata.yaml and the MCAP file's rosbag2 metadata record): the ROS 2
 #: release whose bag format, message definitions and type hashes the bag has. rosbags writes
 #: "rosbags" there and has no option for it, so the recorder rewrites it (_set_ros_distro).
@@ -149,6 +160,9 @@ class Recorder:
         self.subs: dict[str, Any] = {}
         self.conns: dict[str, Any] = {}
         self.counts: dict[str, int] = {}
+        self.expected: dict[str, int] = {}  # topic -> publishers seen when it was subscribed
+        self._snapshot_requests: dict[str, StateRequest] = {}
+        self.saved: list[str] = []  # snapshot topics whose state at the recording's start is in the bag
         self.closed = False
         self._timer = node.create_timer(0.2, self.discover)
         self.discover()
@@ -167,7 +181,7 @@ class Recorder:
             if self.wanted is None:
                 if name in EXCLUDED:
                     continue
-            elif name not in self.wanted:
+            elif name not in self.wanted and types[0] != SNAPSHOT_TYPE:
                 continue
             pubs = [p for p in self.node.get_publishers_info_by_topic(name)
                     if p.node_name != self.node.get_name()
@@ -198,6 +212,7 @@ class Recorder:
             offered_qos_profiles=[bag_qos(p.qos_profile) for p in pubs])
         self.conns[topic] = conn
         self.counts[topic] = 0
+        self.expected[topic] = len(pubs)
 
         def cb(data: bytes, info: Any, topic: str = topic, conn: Any = conn) -> None:
             if self.closed:
@@ -205,8 +220,33 @@ class Recorder:
             ts = info["received_timestamp"] if isinstance(info, dict) else time.time_ns()
             self.writer.write(conn, int(ts), data)
             self.counts[topic] += 1
+            if topic in self._snapshot_requests and self._snapshot_requests[topic].on_message(data):
+                self.saved.append(topic)
 
         self.subs[topic] = self.node.create_subscription(cls, topic, cb, qos, raw=True)
+        if msgtype == SNAPSHOT_TYPE:
+            self._snapshot_requests[topic] = StateRequest(self, topic)
+
+    def wants(self, topic: str) -> bool:
+        return self.wanted is None or topic in self.wanted
+
+    def matched(self, topic: str) -> bool:
+        """This recorder's subscription to ``topic`` has matched every publisher it was made for that is
+        still in the graph (rmw's matched count: what it receives from now on)."""
+        sub = self.subs.get(topic)
+        if sub is None:
+            return False
+        in_graph = sum(1 for p in self.node.get_publishers_info_by_topic(topic)
+                       if p.node_name != self.node.get_name() or p.node_namespace != self.node.get_namespace())
+        return sub.get_publisher_count() >= min(self.expected[topic], in_graph)
+
+    def recording(self) -> bool:
+        """Every topic subscribed so far has matched its publishers, and every node whose ~/snapshot is
+        recorded has its state at the start in the bag, taken once its writers had matched this
+        recorder's readers. Messages sent before this may be missing from the bag."""
+        subs = self.subscribed()
+        return (bool(subs) and all(self.matched(t) for t in subs)
+                and all(r.done for r in self._snapshot_requests.values()))
 
     def subscribed(self) -> list[str]:
         return sorted(t for t, s in self.subs.items() if s is not None)
@@ -220,6 +260,78 @@ class Recorder:
                     self.node.destroy_subscription(s)
             _set_ros_distro(self.writer)
         return dict(self.counts)
+
+
+class StateRequest:
+    """Gets a node's state at the start of the recording into the bag, from the node's ``~/snapshot``.
+
+    The node's latched snapshot (from its start or last reset) arrives first and names the topics a
+    replay needs from the node (its ``matched_readers``). Once this recorder's subscriptions to them
+    have matched the node's publishers, it calls the node's ``~/save_snapshot``. The next snapshot holds
+    the node's state and how many readers each of those writers had matched at that moment; it is
+    the start when every count reaches the subscriptions the graph shows (this recorder's included),
+    so every message the node sends after it reaches the bag. Otherwise the recorder asks again. The
+    service's answer is not waited for: an answer sent before the client's reader has matched is
+    dropped, so the snapshot message is the proof. A request can be dropped the same way: with no
+    snapshot RESEND_POLLS polls after a call, it calls again (a second snapshot does no harm)."""
+
+    PERIOD = 0.1  # s between polls
+    RESEND_POLLS = 10
+
+    def __init__(self, rec: Recorder, topic: str) -> None:
+        from std_srvs.srv import Trigger
+
+        self.rec, self.topic = rec, topic
+        # ~/snapshot's sibling ~/save_snapshot
+        self.client = rec.node.create_client(Trigger, topic.rsplit("/", 1)[0] + "/" + SAVE_SERVICE)
+        self.request = Trigger.Request()
+        self.needed: list[str] | None = None  # absolute topics a replay needs, from the first snapshot
+        self.sent = False   # a call is out and no snapshot arrived since
+        self.polls_since_call = 0
+        self.done = False
+        self.asked = 0      # calls made
+        self.unmatched: list[str] = []  # the last snapshot's topics whose writer had not matched us
+        self.timer = rec.node.create_timer(self.PERIOD, self.poll)
+
+    def poll(self) -> None:
+        if self.done or self.needed is None or self.rec.closed:
+            return
+        if self.sent:
+            self.polls_since_call += 1
+            if self.polls_since_call < self.RESEND_POLLS:
+                return
+        if not all(self.rec.matched(t) for t in self.needed) or not self.client.service_is_ready():
+            return
+        self.sent = True
+        self.polls_since_call = 0
+        self.asked += 1
+        self.client.call_async(self.request)
+
+    def on_message(self, data: bytes) -> bool:
+        """A snapshot arrived; True once it is the recording's start."""
+        if self.done:
+            return False
+        from libcollide_msgs.msg import WorldSnapshot
+        from rclpy.serialization import deserialize_message
+
+        counts = json.loads(deserialize_message(data, WorldSnapshot).node_state).get("matched_readers", {})
+        topics = {t: n for t, n in counts.items() if self.rec.wants(t)}
+        if self.needed is None:
+            self.needed = sorted(topics)
+        if not self.sent:
+            return False  # the latched one, from before the call
+        self.sent = False
+        self.unmatched = [t for t, n in sorted(topics.items())
+                          if not self.rec.matched(t) or n < len(self.rec.node.get_subscriptions_info_by_topic(t))]
+        if self.unmatched:
+            if self.asked in (10, 100):  # say why the recording has not started, not on every call
+                self.rec.node.get_logger().warning(
+                    f"{self.topic}: after {self.asked} snapshots, the node's writers on "
+                    f"{', '.join(self.unmatched)} have not matched every subscription the graph shows yet")
+            return False  # poll() asks again
+        self.done = True
+        self.rec.node.destroy_timer(self.timer)
+        return True
 
 
 def _ros_distro_yaml(text: str) -> str:
@@ -287,11 +399,11 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--topics", nargs="*", default=None,
                    help="topics to record (relative names resolve in the recorder's "
                         "namespace); default: every topic except /rosout, /parameter_events")
-    p.add_argument("--duration", type=float, default=0.0, help="stop after S seconds (0 = on signal)")
+    p.add_argument("--duration", type=float, default=0.0, help="stop S seconds after 'recording' (0 = on signal)")
     p.add_argument("--node-name", default="recorder")
     p.add_argument("--params-of", default=None, metavar="NODE",
                    help="store this node's parameters (e.g. 'sim') in the bag's custom_data, "
-                        "for replay")
+                        "for readers of the bag (the replay takes them from the node's ~/snapshot)")
     a = p.parse_args(argv)
     if Path(a.out).exists():
         p.error(f"{a.out} exists already")
@@ -316,15 +428,26 @@ def main(argv: list[str] | None = None) -> int:
     ex = SingleThreadedExecutor()
     ex.add_node(node)
     print(f"recorder: writing {a.out} (mcap, rosbag2 v9)", flush=True)
-    t_end = time.monotonic() + a.duration if a.duration > 0 else float("inf")
+    t0 = time.monotonic()
+    since: float | None = None  # when it reported "recording"; --duration counts from there
     announced: set[str] = set()
+    saved: list[str] = []
     try:
-        while not stop["flag"] and time.monotonic() < t_end:
+        while not stop["flag"] and not (since is not None and 0 < a.duration <= time.monotonic() - since):
             ex.spin_once(timeout_sec=0.05)
             new = set(rec.subscribed()) - announced
             for t in sorted(new):
                 print(f"recorder: subscribed {t}", flush=True)
             announced |= new
+            while len(saved) < len(rec.saved):
+                saved.append(rec.saved[len(saved)])
+                asked = rec._snapshot_requests[saved[-1]].asked
+                print(f"recorder: state saved on {saved[-1]} ({asked} call{'s' * (asked > 1)} to "
+                      f"{SAVE_SERVICE})", flush=True)
+            if since is None and rec.recording():
+                since = time.monotonic()
+                print(f"recorder: recording ({len(announced)} topics matched, {since - t0:.2f} s after "
+                      "the start)", flush=True)
     finally:
         counts = rec.close()
         ex.remove_node(node)

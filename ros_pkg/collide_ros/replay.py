@@ -1,44 +1,60 @@
-"""Replay a recorded bag's commands into a fresh sim node and check the poses bit for bit.
+"""Replay a recorded bag from the sim's state at its start and check the states bit for bit.
 
-    python -m collide_ros.replay BAG [--node-cmd CMD] [--json]
+    python -m collide_ros.replay BAG [--json]
 
-Design (docs/contracts.md, "Command echo for bit-exact replay"): the node republishes every
-command it accepts on `applied/<command topic>` with header.stamp = the sim time of the
-first step the command acts on, and the recorder stores those echoes. To reproduce the run,
-this tool starts a fresh node with `start_paused:=true` and the parameters the recorder
-stored in the bag (custom_data "collide_ros.params"), then for each echoed command in order:
-advance the node with `~/step` to step round(stamp / time_step), publish the command on its
-topic, and wait for the fresh node's own echo with the same stamp (so the command is in the
-node before the next step is requested). After the last command it steps to the last
-recorded state and compares every recorded `bodies/states` message with the replayed one of
-the same stamp: names, poses and twists must be equal bit for bit (float64 bit patterns).
-The command watchdog runs on sim time, so it reproduces by itself.
-Limits: the recording must start before the first command (the fresh node replays from
-t = 0), and parameter changes, resets, spawns and kills during the recording are not replayed.
+The node publishes its state on ``~/snapshot`` (libcollide_msgs/WorldSnapshot: the world's snapshot,
+the sim time, the parameters, the step count, the commands in force) when it starts, after each reset
+and when the recorder starts recording (it calls ``~/save_snapshot``), and the recorder always records
+it. The node also republishes every command it accepts on ``applied/<topic>``, stamped with the sim
+time of the first step it acts on (docs/contracts.md), and the recorder records those echoes.
+
+The replay builds a sim node in this process (paused, never spinning, its topics in a private
+namespace, no /clock or /tf), loads the bag's latest snapshot into it and steps it from there: before
+each step it hands the node the echoed commands stamped with that step's start, through the node's
+own subscription callbacks; after each step it compares the node's ``bodies/states`` message with
+the recorded one of the same stamp, CDR byte for byte. Only the recorded span is stepped, the bag is
+read as a stream (two readers, a bounded look-ahead for the commands), and SIGINT or SIGTERM ends
+the replay after the current step with a verdict saying how far it got.
+
+Verdict and exit status: 0 every recorded state from the snapshot on reproduced bit for bit; 1 a
+mismatch (the first one's sim time and size are printed) or a step that failed; 2 the bag cannot be
+replayed (no snapshot, no states, a snapshot with springs made over ROS or spawned bodies); 3 stopped by a signal
+before the end, with no mismatch up to there.
+Limits: the states before the bag's latest snapshot (e.g. before a reset during the recording) are
+not checked; parameter changes, spawns and kills during the recording are not replayed.
 """
 from __future__ import annotations
 
 import argparse
+import heapq
 import json
 import os
-import shlex
 import signal
-import subprocess
 import sys
-import tempfile
-import time
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from .cdr import join_time
-from .recorder import PARAMS_KEY
+from .recorder import PARAMS_KEY, SNAPSHOT_TYPE
 
 APPLIED = "applied/"
-#: parameters never passed to the fresh node
-SKIP_PARAMS = frozenset({"use_sim_time", "start_paused"})
+#: parameters the replay node does not take from the snapshot (it sets them itself)
+SKIP_PARAMS = frozenset({"use_sim_time", "start_paused", "publish_clock", "tf_rate"})
+#: commands read ahead of the one applied next: the recorder receives the echo topics on separate
+#: subscriptions, so same-step commands of different topics can arrive in either order
+LOOKAHEAD = 256
+#: command line that starts a sim node (tools that run one: the demo)
+NODE_CMD = [sys.executable, "-m", "collide_ros.node"]
+
+
+@dataclass
+class Snapshot:
+    stamp: int               # ns of sim time
+    state: dict[str, Any]    # node_state JSON: params, steps, time_offset, commands in force
+    world: bytes
 
 
 @dataclass
@@ -49,11 +65,8 @@ class Command:
     raw: bytes        # CDR of the echo
 
 
-@dataclass
-class States:
-    stamp: int
-    names: list[str]
-    values: np.ndarray  # (n, 13): px py pz qx qy qz qw vx vy vz wx wy wz
+def _ns(stamp: Any) -> int:
+    return int(stamp.sec) * 1_000_000_000 + int(stamp.nanosec)
 
 
 def _split_ns(topic: str, rel: str) -> str | None:
@@ -65,18 +78,8 @@ def _split_ns(topic: str, rel: str) -> str | None:
     return None
 
 
-def states_from_msg(msg: Any) -> States:
-    vals = np.array([[p.position.x, p.position.y, p.position.z, p.orientation.x, p.orientation.y,
-                      p.orientation.z, p.orientation.w, t.linear.x, t.linear.y, t.linear.z,
-                      t.angular.x, t.angular.y, t.angular.z]
-                     for p, t in zip(msg.poses, msg.twists)], dtype=np.float64).reshape(-1, 13)
-    st = msg.header.stamp
-    return States(stamp=int(st.sec) * 1_000_000_000 + int(st.nanosec), names=list(msg.names),
-                  values=vals)
-
-
 def bag_params(bag: str | Path) -> dict[str, Any]:
-    """The node parameters the recorder stored in the bag's metadata (custom_data)."""
+    """The node parameters the recorder stored in the bag's metadata (custom_data, --params-of)."""
     import yaml
 
     meta = yaml.safe_load((Path(bag) / "metadata.yaml").read_text())
@@ -84,312 +87,256 @@ def bag_params(bag: str | Path) -> dict[str, Any]:
     return json.loads(custom[PARAMS_KEY]) if PARAMS_KEY in custom else {}
 
 
-def read_recording(bag: str | Path) -> tuple[list[Command], list[States], dict[str, Any], str]:
-    """(commands in apply order, recorded states, node parameters, namespace) of a bag."""
+def start_snapshot(bag: str | Path, store: Any) -> Snapshot | None:
+    """The bag's snapshot of the latest sim time (the state the replay starts from), or None."""
     from rosbags.rosbag2 import Reader
 
+    best: Snapshot | None = None
+    with Reader(Path(bag)) as r:
+        conns = [c for c in r.connections if c.msgtype == SNAPSHOT_TYPE]
+        if not conns:
+            return None
+        for conn, _ts, raw in r.messages(connections=conns):
+            msg = store.deserialize_cdr(raw, conn.msgtype)
+            stamp = _ns(msg.stamp)
+            if best is None or stamp >= best.stamp:
+                best = Snapshot(stamp, json.loads(msg.node_state), bytes(msg.world))
+    return best
+
+
+def iter_states(bag: str | Path, store: Any) -> Iterator[tuple[int, bytes]]:
+    """(stamp, CDR) of every recorded bodies/states message, in bag order."""
+    from rosbags.rosbag2 import Reader
+
+    with Reader(Path(bag)) as r:
+        conns = [c for c in r.connections if _split_ns(c.topic, "bodies/states") is not None]
+        if not conns:
+            return  # Reader.messages(connections=[]) would yield every message of the bag
+        for conn, _ts, raw in r.messages(connections=conns):
+            yield _ns(store.deserialize_cdr(raw, conn.msgtype).header.stamp), bytes(raw)
+
+
+def iter_commands(bag: str | Path, store: Any) -> Iterator[Command]:
+    """The echoed commands in apply order (stamp, then arrival), read ahead by LOOKAHEAD messages."""
+    from rosbags.rosbag2 import Reader
+
+    heap: list[tuple[int, int, Command]] = []
+    with Reader(Path(bag)) as r:
+        conns = [c for c in r.connections if c.topic.find("/" + APPLIED) >= 0]
+        if not conns:
+            return  # no command echoes recorded; messages(connections=[]) would yield them all
+        for seq, (conn, _ts, raw) in enumerate(r.messages(connections=conns)):
+            t = conn.topic
+            rel = t[t.find("/" + APPLIED) + 1 + len(APPLIED):]
+            stamp = _ns(store.deserialize_cdr(raw, conn.msgtype).header.stamp)
+            heapq.heappush(heap, (stamp, seq, Command(stamp, rel, conn.msgtype, bytes(raw))))
+            if len(heap) > LOOKAHEAD:
+                yield heapq.heappop(heap)[2]
+    while heap:
+        yield heapq.heappop(heap)[2]
+
+
+def states_values(store: Any, raw: bytes) -> tuple[list[str], np.ndarray]:
+    """Names and (n, 13) pose and twist doubles of a bodies/states CDR message."""
+    msg = store.deserialize_cdr(raw, "libcollide_msgs/msg/BodyStates")
+    vals = np.array([[p.position.x, p.position.y, p.position.z, p.orientation.x, p.orientation.y,
+                      p.orientation.z, p.orientation.w, t.linear.x, t.linear.y, t.linear.z,
+                      t.angular.x, t.angular.y, t.angular.z]
+                     for p, t in zip(msg.poses, msg.twists)], dtype=np.float64).reshape(-1, 13)
+    return list(msg.names), vals
+
+
+class _Capture:
+    """Stands in for the replay node's bodies/states publisher: keeps the last message, sends nothing."""
+
+    def __init__(self) -> None:
+        self.count = 0
+        self.last: bytes | None = None
+
+    def publish(self, msg: Any) -> None:
+        self.last = bytes(msg)
+        self.count += 1
+
+
+def _make_node(snap: Snapshot) -> Any:
+    from rclpy.parameter import Parameter
+
+    from .node import SimNode
+
+    params = {k: v for k, v in snap.state["params"].items()
+              if k not in SKIP_PARAMS and not k.startswith("qos_overrides")}
+    overrides = [Parameter(k, value=v) for k, v in params.items()]
+    overrides += [Parameter("start_paused", value=True), Parameter("publish_clock", value=False),
+                  Parameter("tf_rate", value=0.0)]
+    # a namespace of its own: nothing of the replay reaches a live sim's topics or theirs the replay
+    node = SimNode(namespace=f"/collide_replay_{os.getpid()}", parameter_overrides=overrides)
+    try:
+        node.restore_snapshot(snap.world, snap.state)
+    except Exception:
+        node.destroy_node()
+        raise
+    return node
+
+
+def _deliver(node: Any, c: Command, subs: dict[str, Any], cmd_vel_stamped: bool) -> None:
+    """Hand an echoed command to the node's own subscription callback (as if it had arrived)."""
+    from rclpy.serialization import deserialize_message
+
+    from .recorder import msg_class
+
+    sub = subs.get(c.topic)
+    if sub is None:
+        want = node.resolve_topic_name(c.topic)
+        sub = next((s for s in node.subscriptions if s.topic_name == want), None)
+        if sub is None:
+            raise ValueError(f"the replay node has no subscription {c.topic}")
+        subs[c.topic] = sub
+    msg = deserialize_message(c.raw, msg_class(c.msgtype))
+    if c.topic == "cmd_vel" and not cmd_vel_stamped:
+        msg = msg.twist
+    sub.callback(msg, {})
+
+
+def replay(bag: str | Path, delay_command: int | None = None,
+           stop: Callable[[], bool] = lambda: False,
+           on_start: Callable[[Snapshot], None] | None = None) -> dict[str, Any]:
+    """Replay the bag's recorded span; returns the verdict. rclpy must be initialised.
+
+    `stop` is polled before each step (a signal's flag); `on_start` is called once the node holds
+    the snapshot. `delay_command` (for tests): apply that
+    command (index in apply order) one step late, to show that the comparison notices it."""
+    from .cdr import split_time
     from .recorder import make_typestore
 
     store = make_typestore()
-    cmds: list[tuple[int, int, Command]] = []
-    states: list[States] = []
-    ns = None
-    with Reader(Path(bag)) as r:
-        params = bag_params(bag)
-        seq = 0
-        for conn, _ts, raw in r.messages():
-            t = conn.topic
-            k = t.find("/" + APPLIED)
-            if k >= 0:
-                ns_c, rel = t[:k], t[k + 1 + len(APPLIED):]
-                msg = store.deserialize_cdr(raw, conn.msgtype)
-                st = msg.header.stamp
-                stamp = int(st.sec) * 1_000_000_000 + int(st.nanosec)
-                cmds.append((stamp, seq, Command(stamp, rel, conn.msgtype, bytes(raw))))
-                seq += 1
-                ns = ns_c if ns is None else ns
-            elif _split_ns(t, "bodies/states") is not None:
-                states.append(states_from_msg(store.deserialize_cdr(raw, conn.msgtype)))
-                ns = _split_ns(t, "bodies/states") if ns is None else ns
-    cmds.sort(key=lambda c: (c[0], c[1]))  # stable: same-stamp commands keep arrival order
-    states.sort(key=lambda s: s.stamp)
-    return [c for _, _, c in cmds], states, params, ns or ""
+    snap = start_snapshot(bag, store)
+    if snap is None:
+        raise ValueError(f"{bag}: no {SNAPSHOT_TYPE} message (the node's ~/snapshot); record with "
+                         "collide_ros.recorder from a node that publishes it")
+    node = _make_node(snap)
+    try:
+        if on_start is not None:
+            on_start(snap)
+        cap = _Capture()
+        node._pub_states = cap
+        # the state at the snapshot itself: a recorded state of the snapshot's stamp (published by the
+        # step the snapshot was taken after) is compared with it, not stepped to
+        node._publish_state()
+        dt = float(node._p["time_step"])
+        stamped = bool(node._p["cmd_vel_stamped"])
+        rejected0 = node.rejected
 
+        def now() -> int:
+            sec, ns = split_time(node.sim_time)
+            return sec * 1_000_000_000 + ns
 
-def params_file(params: dict[str, Any], path: Path) -> Path:
-    import yaml
-
-    keep = {k: v for k, v in params.items() if k not in SKIP_PARAMS and not k.startswith("qos_overrides")}
-    keep["start_paused"] = True
-    path.write_text(yaml.safe_dump({"/**": {"ros__parameters": keep}}))
-    return path
-
-
-def compare(recorded: list[States], replayed: dict[int, States]) -> dict[str, Any]:
-    """Bitwise comparison of every recorded state with the replayed state of the same stamp."""
-    compared = identical = missing = 0
-    max_diff = 0.0
-    first_bad: int | None = None
-    for s in recorded:
-        r = replayed.get(s.stamp)
-        if r is None:
-            missing += 1
-            continue
-        compared += 1
-        same = (r.names == s.names and r.values.shape == s.values.shape
-                and np.array_equal(r.values.view(np.uint64), s.values.view(np.uint64)))
-        if same:
-            identical += 1
-        else:
-            if r.values.shape == s.values.shape:
-                max_diff = max(max_diff, float(np.max(np.abs(r.values - s.values))))
-            else:
-                max_diff = float("inf")
-            if first_bad is None:
-                first_bad = s.stamp
-    return {"recorded": len(recorded), "compared": compared, "identical": identical,
-            "missing": missing, "max_abs_diff": max_diff,
-            "first_mismatch_s": None if first_bad is None else first_bad * 1e-9,
-            "ok": compared > 0 and identical == compared and missing == 0}
-
-
-class Replayer:
-    """In-process ROS side: publishers for the commands, echo and state subscriptions, ~/step."""
-
-    def __init__(self, node_name: str = "sim", cmd_vel_stamped: bool = False,
-                 time_step: float = 0.001) -> None:
-        import rclpy
-        from libcollide_msgs.msg import BodyStates
-        from libcollide_msgs.srv import Step
-        from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
-
-        self.rclpy = rclpy
-        self.node = rclpy.create_node("replay")
-        self.qos_cmd = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
-        self.qos_in = QoSProfile(history=HistoryPolicy.KEEP_ALL, reliability=ReliabilityPolicy.RELIABLE)
-        self.cmd_vel_stamped = cmd_vel_stamped
-        self.pubs: dict[str, Any] = {}
-        self.echo_subs: dict[str, Any] = {}
-        self.echoes: list[tuple[str, int]] = []
-        self.states: dict[int, States] = {}
-        self.node.create_subscription(BodyStates, "bodies/states", self._on_states, self.qos_in, raw=True)
-        self._states_cls = BodyStates
-        self.step_cli = self.node.create_client(Step, f"{node_name}/step")
-        self._step_cls = Step
-        self.steps = 0
-        self.sim_time = 0.0
-        self.time_step = time_step
-
-    def _on_states(self, raw: bytes) -> None:
-        from rclpy.serialization import deserialize_message
-
-        s = states_from_msg(deserialize_message(raw, self._states_cls))
-        self.states[s.stamp] = s
-
-    def _msgcls(self, msgtype: str) -> Any:
-        from .recorder import msg_class
-        return msg_class(msgtype)
-
-    def prepare(self, cmds: list[Command]) -> None:
-        """Create one publisher and one echo subscription per command topic."""
-        for c in cmds:
-            if c.topic in self.pubs:
+        out: dict[str, Any] = {"start_s": snap.stamp * 1e-9, "time_step": dt, "recorded": 0, "compared": 0,
+                               "identical": 0, "missing": 0, "skipped": 0, "commands": 0, "steps": 0,
+                               "first_mismatch_s": None, "first_mismatch_size": None, "max_abs_diff": 0.0,
+                               "stopped": False, "failed_step_s": None}
+        cmds = iter_commands(bag, store)
+        pending = next(cmds, None)
+        subs: dict[str, Any] = {}
+        index = 0
+        cur = now()
+        for stamp, raw in iter_states(bag, store):
+            out["recorded"] += 1
+            if stamp < snap.stamp:
+                out["skipped"] += 1  # before the state the replay starts from
                 continue
-            if c.topic == "cmd_vel" and not self.cmd_vel_stamped:
-                from geometry_msgs.msg import Twist
-                cls = Twist
-            else:
-                cls = self._msgcls(c.msgtype)
-            self.pubs[c.topic] = (self.node.create_publisher(cls, c.topic, self.qos_cmd), cls)
-
-            def on_echo(raw: bytes, topic: str = c.topic, ecls: Any = self._msgcls(c.msgtype)) -> None:
-                from rclpy.serialization import deserialize_message
-                st = deserialize_message(raw, ecls).header.stamp
-                self.echoes.append((topic, int(st.sec) * 1_000_000_000 + int(st.nanosec)))
-
-            self.echo_subs[c.topic] = self.node.create_subscription(
-                self._msgcls(c.msgtype), APPLIED + c.topic, on_echo, self.qos_in, raw=True)
-
-    def wait_ready(self, timeout: float) -> bool:
-        """Wait until the fresh node's step service, command subscriptions and publishers match."""
-        end = time.monotonic() + timeout
-        while time.monotonic() < end:
-            ok = self.step_cli.service_is_ready()
-            ok = ok and all(p.get_subscription_count() > 0 for p, _ in self.pubs.values())
-            ok = ok and all(self.node.count_publishers(s.topic_name) > 0 for s in self.echo_subs.values())
-            ok = ok and self.node.count_publishers("bodies/states") > 0
-            if ok:
-                return True
-            self.rclpy.spin_once(self.node, timeout_sec=0.05)
-        return False
-
-    def spin_for(self, seconds: float) -> None:
-        end = time.monotonic() + seconds
-        while time.monotonic() < end:
-            self.rclpy.spin_once(self.node, timeout_sec=0.01)
-
-    def _call_step(self, k: int, timeout: float) -> Any:
-        """One ~/step call; None when no answer came within `timeout` s."""
-        req = self._step_cls.Request()
-        req.steps = k
-        fut = self.step_cli.call_async(req)
-        self.rclpy.spin_until_future_complete(self.node, fut, timeout_sec=timeout)
-        return fut.result() if fut.done() else None
-
-    def handshake(self, timeout: float, attempt: float = 2.0) -> Any:
-        """Call ~/step with 0 steps until an answer comes back; returns it (None on timeout).
-
-        `service_is_ready()` shows only that requests reach the node. The answer travels on a
-        second DDS topic whose two ends match on their own schedule, and an answer sent before
-        they have matched is dropped (rmw_fastrtps waits 100 ms, then gives up; a loaded CI
-        machine lost the first ~/step answer of a replay that way). A zero-step call changes
-        nothing, so it can be repeated until one answer proves the way back."""
-        end = time.monotonic() + timeout
-        while time.monotonic() < end:
-            res = self._call_step(0, min(attempt, max(end - time.monotonic(), 0.01)))
-            if res is not None:
-                return res
-        return None
-
-    def step(self, n: int, chunk: int = 50, timeout: float = 30.0) -> None:
-        """Advance the paused node by n steps (in chunks, draining states in between)."""
-        while n > 0:
-            k = min(n, chunk)
-            res = self._call_step(k, timeout)
-            if res is None:
-                # the answer may be lost rather than late: ask where the node is, via zero-step
-                # calls, before deciding whether these k steps happened
-                probe = self.handshake(timeout)
-                if probe is None:
-                    raise RuntimeError(f"~/step {k} failed: timeout, and the node answers no zero-step call")
-                t = join_time(probe.sim_time)
-                moved = round((t - self.sim_time) / self.time_step)
-                if moved == 0:
-                    continue  # the request was lost: send it again
-                if moved != k:
-                    raise RuntimeError(f"~/step {k}: the answer was lost and the node moved {moved} steps")
-                res = probe
-            elif not res.success:
-                raise RuntimeError(f"~/step {k} failed: {res.message}")
-            self.sim_time = join_time(res.sim_time)
-            self.steps += k
-            n -= k
-            self.rclpy.spin_once(self.node, timeout_sec=0.0)
-
-    def send(self, c: Command, timeout: float = 10.0, check_stamp: bool = True) -> None:
-        """Publish a command and wait for the node's echo with the same stamp."""
-        from rclpy.serialization import deserialize_message
-
-        pub, cls = self.pubs[c.topic]
-        if c.topic == "cmd_vel" and not self.cmd_vel_stamped:
-            pub.publish(deserialize_message(c.raw, self._msgcls(c.msgtype)).twist)
-        else:
-            pub.publish(c.raw)
-        end = time.monotonic() + timeout
-        while time.monotonic() < end:
-            for i, (topic, stamp) in enumerate(self.echoes):
-                if topic == c.topic:
-                    del self.echoes[i]
-                    if check_stamp and stamp != c.stamp:
-                        raise RuntimeError(
-                            f"{c.topic}: fresh node applied the command at {stamp * 1e-9:.9f} s, "
-                            f"recorded {c.stamp * 1e-9:.9f} s")
-                    return
-            self.rclpy.spin_once(self.node, timeout_sec=0.01)
-        raise RuntimeError(f"no echo on {APPLIED}{c.topic} within {timeout} s (does the node echo "
-                           "accepted commands? docs/contracts.md)")
-
-    def close(self) -> None:
-        self.node.destroy_node()
+            while cur < stamp and not out["stopped"] and out["failed_step_s"] is None:
+                while pending is not None and (pending.stamp < cur if index == delay_command
+                                               else pending.stamp <= cur):
+                    if pending.stamp >= snap.stamp:  # older ones are in the snapshot's commands in force
+                        _deliver(node, pending, subs, stamped)
+                        out["commands"] += 1
+                        index += 1
+                    pending = next(cmds, None)
+                if stop():
+                    out["stopped"] = True
+                    break
+                if not node.step_once():
+                    out["failed_step_s"] = node.sim_time
+                    break
+                out["steps"] += 1
+                cur = now()
+            if out["stopped"] or out["failed_step_s"] is not None:
+                break
+            mine = cap.last
+            if cur != stamp or mine is None:
+                out["missing"] += 1
+                continue
+            out["compared"] += 1
+            if mine == raw:
+                out["identical"] += 1
+                continue
+            rn, rv = states_values(store, raw)
+            mn, mv = states_values(store, mine)
+            diff = float(np.max(np.abs(rv - mv))) if rn == mn and rv.shape == mv.shape else float("inf")
+            out["max_abs_diff"] = max(out["max_abs_diff"], diff)
+            if out["first_mismatch_s"] is None:
+                out["first_mismatch_s"], out["first_mismatch_size"] = stamp * 1e-9, diff
+        if out["recorded"] == 0:
+            raise ValueError(f"{bag}: no bodies/states messages")
+        out["reached_s"] = node.sim_time
+        out["rejected"] = node.rejected - rejected0
+        out["ok"] = (out["compared"] > 0 and out["identical"] == out["compared"] and out["missing"] == 0
+                     and not out["stopped"] and out["failed_step_s"] is None)
+        return out
+    finally:
+        node.destroy_node()
 
 
-#: command line that starts a sim node (it echoes accepted commands: SimNode.ECHOES_COMMANDS)
-NODE_CMD = [sys.executable, "-m", "collide_ros.node"]
-
-
-def replay(bag: str | Path, node_cmd: list[str] | None = None, env: dict[str, str] | None = None,
-           log: Any = None, delay_command: int | None = None) -> dict[str, Any]:
-    """Run the whole replay; returns the comparison summary. rclpy must be initialised.
-
-    `delay_command` (for tests): apply that command (index in apply order) one step late, to
-    show that the comparison notices a one-step difference."""
-    cmds, recorded, params, _ns = read_recording(bag)
-    if not recorded:
-        raise ValueError(f"{bag}: no bodies/states messages")
-    if not params:
-        raise ValueError(f"{bag}: no node parameters in custom_data[{PARAMS_KEY!r}] "
-                         "(record with --params-of sim)")
-    dt = float(params.get("time_step", 0.001))
-    node_cmd = node_cmd or NODE_CMD
-    env = dict(os.environ if env is None else env)
-    with tempfile.TemporaryDirectory() as tmp:
-        pf = params_file(params, Path(tmp) / "params.yaml")
-        proc = subprocess.Popen(node_cmd + ["--ros-args", "--params-file", str(pf)], env=env,
-                                stdout=log or subprocess.DEVNULL, stderr=subprocess.STDOUT)
-        rep = Replayer(cmd_vel_stamped=bool(params.get("cmd_vel_stamped", False)), time_step=dt)
-        try:
-            rep.prepare(cmds)
-            if not rep.wait_ready(60.0):
-                raise RuntimeError("fresh node did not come up (step service / topics)")
-            first = rep.handshake(60.0)
-            if first is None:
-                raise RuntimeError("fresh node's ~/step never answered a zero-step call")
-            rep.sim_time = join_time(first.sim_time)
-            for i, c in enumerate(cmds):
-                k = round(c.stamp * 1e-9 / dt) + (1 if i == delay_command else 0)
-                if k < rep.steps:
-                    raise RuntimeError(f"command at step {k} but the node is already at {rep.steps}")
-                rep.step(k - rep.steps)
-                rep.send(c, check_stamp=i != delay_command)
-            last = round(recorded[-1].stamp * 1e-9 / dt)
-            if last > rep.steps:
-                rep.step(last - rep.steps)
-            # collect the states still in flight
-            end = time.monotonic() + 10.0
-            while time.monotonic() < end and recorded[-1].stamp not in rep.states:
-                rep.spin_for(0.05)
-            rep.spin_for(0.2)
-            out = compare(recorded, rep.states)
-            out.update(commands=len(cmds), steps=rep.steps, time_step=dt,
-                       replayed_states=len(rep.states))
-            return out
-        finally:
-            rep.close()
-            proc.send_signal(signal.SIGINT)  # the node's clean shutdown path
-            try:
-                proc.wait(timeout=10)
-            except subprocess.TimeoutExpired:
-                proc.kill()
-                proc.wait()
+def verdict(res: dict[str, Any]) -> tuple[str, int]:
+    """The one-line verdict and the exit status (module docstring)."""
+    span = (f"from {res['start_s']:.3f} s to {res['reached_s']:.3f} s of sim time, {res['steps']} steps of "
+            f"{res['time_step']} s, {res['commands']} commands; {res['identical']}/{res['compared']} recorded "
+            f"states bit-identical ({res['missing']} missing, {res['skipped']} before the snapshot)")
+    if res["first_mismatch_s"] is not None:
+        return (f"MISMATCH {span}; first at {res['first_mismatch_s']:.9f} s, max |diff| "
+                f"{res['first_mismatch_size']:.3g} there, {res['max_abs_diff']:.3g} overall"), 1
+    if res["failed_step_s"] is not None:
+        return f"FAILED: the step at {res['failed_step_s']:.9f} s failed; {span}", 1
+    if res["stopped"]:
+        return f"STOPPED by a signal, no mismatch up to there; {span}", 3
+    if res["ok"]:
+        return f"OK, reproduced bit for bit {span}", 0
+    return f"MISMATCH {span}", 1
 
 
 def main(argv: list[str] | None = None) -> int:
     import rclpy
+    from rclpy.signals import SignalHandlerOptions
+
+    from collide import CollideError
 
     argv = list(sys.argv[1:] if argv is None else argv)
     p = argparse.ArgumentParser(prog="python -m collide_ros.replay", description=__doc__,
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("bag")
-    p.add_argument("--node-cmd", default=None, help="command that starts the node (default: "
-                   "python -m collide_ros.node)")
-    p.add_argument("--json", action="store_true", help="print the summary as JSON")
+    p.add_argument("--json", action="store_true", help="print the verdict's numbers as JSON too")
     a = p.parse_args(argv)
-    rclpy.init(args=[])
+    flag = {"stop": False}
+
+    def on_signal(signum: int, frame: Any) -> None:
+        flag["stop"] = True
+
+    signal.signal(signal.SIGINT, on_signal)
+    signal.signal(signal.SIGTERM, on_signal)
+    rclpy.init(args=[], signal_handler_options=SignalHandlerOptions.NO)
     try:
-        res = replay(a.bag, shlex.split(a.node_cmd) if a.node_cmd else None)
-    except (RuntimeError, ValueError, FileNotFoundError) as exc:
+        res = replay(a.bag, stop=lambda: flag["stop"], on_start=lambda s: print(
+            f"replay: starting from the snapshot at {s.stamp * 1e-9:.3f} s of sim time", flush=True))
+    except (ValueError, FileNotFoundError, CollideError) as exc:
         print(f"replay: {exc}", file=sys.stderr)
         return 2
     finally:
         rclpy.try_shutdown()
+    text, code = verdict(res)
     if a.json:
         print(json.dumps(res))
-    else:
-        print(f"replay: {res['commands']} commands over {res['steps']} steps of {res['time_step']} s; "
-              f"{res['identical']}/{res['compared']} recorded states bit-identical "
-              f"({res['missing']} missing, max |diff| {res['max_abs_diff']:.3g})")
-        print("replay: OK, poses reproduced bit for bit" if res["ok"] else "replay: MISMATCH")
-    return 0 if res["ok"] else 1
+    print(f"replay: {text}", flush=True)
+    return code
 
 
 if __name__ == "__main__":

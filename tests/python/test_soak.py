@@ -12,7 +12,7 @@ from pathlib import Path
 REPO = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(REPO))
 
-from soak.soak import BLOCKS, recorded_topics, run_soak  # noqa: E402
+from soak.soak import BLOCKS, SNAPSHOT_TOPIC, recorded_topics, run_soak  # noqa: E402
 
 DURATION = 150.0  # wall seconds: ~3e6 steps, ~10 resets, ~75 parameter sets, ~6000 commands. The memory
 # check uses the second half: the node's RSS rises by ~7 MiB in steps over the first ~40-60 s of
@@ -43,7 +43,8 @@ def test_short_soak(tmp_path: Path) -> None:
     for topic, sent in res.commands_sent.items():
         assert res.published[topic] == sent, topic
     # every message published during the recording is in the bag
-    assert set(res.recorded) == set(recorded_topics())
+    assert set(res.recorded) == set(recorded_topics()) | {SNAPSHOT_TOPIC}
+    assert res.recorded[SNAPSHOT_TOPIC] >= res.resets + 2  # the latched one, the recorder's call, each reset
     for topic in recorded_topics():
         assert res.recorded[topic] == res.published[topic], topic
     # a state message names every block, and every topic got traffic

@@ -11,6 +11,7 @@ publishing    poses, states, contacts, energy, /tf, markers, /clock
 scanners      laser scanners on bodies (the scene's ``scanners``): sensor_msgs/LaserScan from C ray casts
 diagnostics   the /diagnostics status
 services      ~/reset, ~/pause, ~/step, ~/kill
+snapshots     ~/snapshot (the state a replay starts from) and ~/save_snapshot
 spawning      ~/spawn and its checks (inside the static bodies' box, no overlap)
 loop          the sleep-until stepping loop and the executor thread
 

@@ -40,6 +40,7 @@ class Services:
         self._schedule_dirty = True
         self._on_topology(deleteall=True)
         self._publish_state()
+        self._publish_snapshot()
         self.get_logger().info(f"reset: {len(self._dyn_names)} dynamic bodies at sim time {self.sim_time:.3f} s")
 
     def _srv_pause(self, req: SetBool.Request, resp: SetBool.Response) -> SetBool.Response:
