@@ -150,7 +150,7 @@ static lc_status fz_check(const lc_world *w, lc_status s, uint64_t hash_before, 
         snprintf(msg, sizeof msg, "%s returned unknown status %d", call, (int)s);
         fz_fail(msg, NULL);
     }
-#ifndef FZ_ALLOW_EMPTY_MESSAGE /* only to explore past that known finding (fuzz/run --explore) */
+#ifndef FZ_ALLOW_EMPTY_MESSAGE /* only to explore past a failure of this check (fuzz/run --explore) */
     if (lc_world_last_error(w) == NULL || lc_world_last_error(w)[0] == '\0') {
         snprintf(msg, sizeof msg, "%s failed with %s but lc_world_last_error() is empty", call, lc_status_string(s));
         fz_fail(msg, NULL);
@@ -769,7 +769,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     {
         /* a regression for slowness carries its own bound on the input's whole work (the replayer sets
          * FZ_WORK_BOUND from fuzz/corpus/step-work-bounds.txt): the per-step bounds above are far above
-         * what such inputs do once fixed, so without it their regression could not fail */
+         * what such inputs do, so only their own bound catches their slowness coming back */
         const char *bound = getenv("FZ_WORK_BOUND");
         char msg[96];
         snprintf(msg, sizeof msg, "%llu units (bound %s)", c.work, bound ? bound : "none");
