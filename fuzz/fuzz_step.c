@@ -438,7 +438,7 @@ static void fz_set_def(fz_in *in, lc_world_def *d)
         case 9: d->toi_max_iterations = fz_int(in, 4, 200); break;
         case 10: d->contact_gap = fz_num(in, 1e-10, 1e-5); break;
         case 11: d->contact_distance = fz_num(in, 1e-6, 1e-3); break;
-        case 12:   /* the threshold follows without a byte of its own, so older inputs decode as before */
+        case 12:   /* the threshold follows from resting_speed, taking no byte, so the corpus keeps its decoding */
             d->resting_speed = fz_num(in, 0.0, 1e-2);
             d->restitution_threshold = 100.0 * d->resting_speed;
             break;

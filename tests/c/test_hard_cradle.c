@@ -1,4 +1,4 @@
-/* test_hard_cradle: a hard case (docs/hard_cases.md) with an exact answer, run for 60 s at dt = 1/60 s, e = 1, no
+/* test_hard_cradle (docs/hard_cases.md): an exact answer, run for 60 s at dt = 1/60 s, e = 1, no
  * friction, no damping, every other setting the engine's default (serial impacts).
  * (5) Newton's cradle in a walled channel (g = 0): a 1 m x 0.5 m 1 kg striker at 5 m/s into five
  *     such blocks 5 cm apart, and into five such blocks with end faces touching; the channel's walls

@@ -1,4 +1,4 @@
-/* test_hard_stacks: hard cases (docs/hard_cases.md) (3) vertical stacks and (7) the 1:1000 mass-ratio stack, run
+/* test_hard_stacks (docs/hard_cases.md): (3) vertical stacks and (7) the 1:1000 mass-ratio stack, run
  * for 60 s at dt = 1/60 s, g = 9.8 m/s^2, every other setting the engine's default.
  * Layout (bench/scenes.py stack() and mass_ratio_stack()): blocks 1 m wide x 0.5 m tall, centred
  * on x = 0, faces exactly touching (gap 0), the lowest on a static floor 20 m x 1 m whose top face
