@@ -1,5 +1,5 @@
 """libcollide against Box2D v3 (pyb2d3), Chipmunk2D (pymunk) and Box2D 2.3 (pybox2d): speed against
-error on the issue-4 scenes. Use bench/run (it installs bench/requirements.txt first).
+error on the seed and hard-case scenes (docs/benchmarks.md). Use bench/run (it installs bench/requirements.txt first).
 
     bench/run [--quick | --full] [--sections wp,ref,impacts,cradle,tunnel,stacks,hard,pyramid,scaling]
     bench/run [--quick] --sections contact    # piles, pushing, friction (bench/contact.py)
@@ -49,7 +49,7 @@ WP_VARIANTS: dict[str, list[tuple[str, dict, tuple[float, ...]]]] = {
                                      DTS[:1])],
 }
 # Trajectory reference (section "ref"): libcollide at its tightest TOI tolerances. Computed at dt 1/60
-# and at 1/960, seeds 1-3 (run of 2026-11-23 12:12, docs/benchmarks.md, trajectory error), it agrees with itself to
+# and at 1/960, seeds 1-3 (docs/benchmarks.md, trajectory error, the check line), it agrees with itself to
 # 2.6e-12 m over 0.5 s, but at 1 s one g = 9.8 seed is 1.7 m apart and by 2 s all are metres apart
 # (chaos), so REF_T = 0.5 s; the check runs to 2 s so that every run shows where the horizon stands.
 REF_T = 0.5

@@ -5,17 +5,16 @@
  * masses (0, negative, NaN, huge), poses, velocities, materials, external forces, thrusters, springs,
  * settings changes, state overwrites, getters with odd capacities, and steps with random dt.
  *
- * Invariants checked (a violation calls fz_fail(), which aborts the harness, never the library):
+ * Invariants checked (a violation calls fz_fail(), fuzz_fail.h, which aborts the harness, never the
+ * library):
  *  - every call either returns LC_OK or returns an error with a non-empty lc_world_last_error(),
  *    and a failed call leaves the state hash unchanged ("the world is unchanged on failure");
  *  - a step, successful or failed, needs at most FZ_MAX_FORCE_EVALS force evaluations,
  *    FZ_MAX_SERIAL_ITERS serial impulse iterations and FZ_MAX_SOLVER_WORK_PER_BODY solver work per body
  *    (work, not wall time: the verdict is the same on any machine, under any load, with or without
  *    sanitizers);
- *  - the input's final world survives a snapshot (lc_world_save / lc_world_load): a world loaded from it
- *    has the same state hash and saves the same bytes, and copies with a byte flipped (the checksum made
- *    right again, so the loader's own checks are what stands) or cut short are refused with a message and
- *    leave the world unchanged, or load (this reads no input, so older inputs decode as before);
+ *  - the input's final world survives a snapshot round trip, and corrupted copies of its snapshot are
+ *    refused or load (fz_check_snapshot, fuzz_snapshot_checks.h, which lists what it checks);
  *  - after every step (successful or not): time and every state number are finite, and no two
  *    bodies (except static-static pairs, which the engine never separates) overlap by more than
  *    FZ_OVERLAP_TOL + round-off, measured here with our own separating-axis test on the world
@@ -24,7 +23,8 @@
  * overlap; resolving that is not the step's job), and a pose change that creates an overlap is
  * undone the same way.
  *
- * Built two ways from this one file:
+ * Built two ways from this file and fuzz_snapshot_checks.c (which includes libcollide/src's internal
+ * snapshot_checksum.h, so both builds add libcollide/src to the include path):
  *  - with clang -fsanitize=fuzzer,address,undefined: the libFuzzer target (fuzz/run);
  *  - with -DFZ_REPLAY_MAIN and any C99 compiler: a replayer that runs the files named on its
  *    command line (or every file in a directory) through the same code (ctest fuzz_step_regressions).
@@ -40,6 +40,8 @@
 #include <sys/stat.h>
 
 #include "collide/collide.h"
+#include "fuzz_fail.h"
+#include "fuzz_snapshot_checks.h"
 
 #define MAX_COMMANDS 48
 #define MAX_STEPS 24
@@ -139,12 +141,6 @@ static int fz_trace(void)
 
 /* ---- failure ------------------------------------------------------------------------------------ */
 
-static void fz_fail(const char *what, const char *detail)
-{
-    fprintf(stderr, "fuzz_step: INVARIANT VIOLATED: %s%s%s\n", what, detail ? ": " : "", detail ? detail : "");
-    abort(); /* the harness's abort (libFuzzer records the input); the library never aborts */
-}
-
 /* A call's status: OK, or an error that says why and left the world as it was. */
 static lc_status fz_check(const lc_world *w, lc_status s, uint64_t hash_before, const char *call)
 {
@@ -154,7 +150,7 @@ static lc_status fz_check(const lc_world *w, lc_status s, uint64_t hash_before, 
         snprintf(msg, sizeof msg, "%s returned unknown status %d", call, (int)s);
         fz_fail(msg, NULL);
     }
-#ifndef FZ_ALLOW_EMPTY_MESSAGE /* only to explore past that known finding (fuzz/run --explore) */
+#ifndef FZ_ALLOW_EMPTY_MESSAGE /* only to explore past a failure of this check (fuzz/run --explore) */
     if (lc_world_last_error(w) == NULL || lc_world_last_error(w)[0] == '\0') {
         snprintf(msg, sizeof msg, "%s failed with %s but lc_world_last_error() is empty", call, lc_status_string(s));
         fz_fail(msg, NULL);
@@ -442,7 +438,7 @@ static void fz_set_def(fz_in *in, lc_world_def *d)
         case 9: d->toi_max_iterations = fz_int(in, 4, 200); break;
         case 10: d->contact_gap = fz_num(in, 1e-10, 1e-5); break;
         case 11: d->contact_distance = fz_num(in, 1e-6, 1e-3); break;
-        case 12:   /* the threshold follows without a byte of its own, so older inputs decode as before */
+        case 12:   /* the threshold follows from resting_speed, taking no byte, so the corpus keeps its decoding */
             d->resting_speed = fz_num(in, 0.0, 1e-2);
             d->restitution_threshold = 100.0 * d->resting_speed;
             break;
@@ -735,83 +731,6 @@ static void fz_command(fz_in *in, fz_ctx *c)
     }
 }
 
-/* ---- snapshots ------------------------------------------------------------------------------------- */
-
-static uint64_t fz_fnv1a(const uint8_t *p, size_t n)
-{
-    uint64_t h = 1469598103934665603ULL;
-    size_t i;
-    for (i = 0; i < n; ++i) {
-        h ^= p[i];
-        h *= 1099511628211ULL;
-    }
-    return h;
-}
-
-/* The snapshot's checksum (header bytes 24..31, little-endian, docs/events_and_snapshots.md) made right
- * for its payload (from byte 32). */
-static void fz_fix_checksum(uint8_t *p, size_t n)
-{
-    uint64_t h = fz_fnv1a(p + 32, n - 32);
-    int k;
-    for (k = 0; k < 8; ++k) p[24 + k] = (uint8_t)(h >> (8 * k));
-}
-
-/* A load of the n bytes at p into c->w: refused with a message and the world's snapshot (was) unchanged,
- * or accepted, after which the world goes back to was. */
-static void fz_load_or_refuse(fz_ctx *c, const uint8_t *p, size_t n, const uint8_t *was, size_t was_n)
-{
-    uint64_t h = lc_world_state_hash(c->w);
-    lc_status s = lc_world_load(c->w, p, n);
-    if (s == LC_OK) {
-        if (lc_world_load(c->w, was, was_n) != LC_OK) fz_fail("the world's own snapshot does not load", lc_world_last_error(c->w));
-        return;
-    }
-    if (lc_world_last_error(c->w)[0] == '\0') fz_fail("a refused snapshot left no message", NULL);
-    if (lc_world_state_hash(c->w) != h) fz_fail("a refused snapshot changed the world", lc_world_last_error(c->w));
-    {
-        size_t m = 0;
-        uint8_t *now = malloc(was_n);
-        if (now == NULL) return;
-        if (lc_world_save(c->w, now, was_n, &m) != LC_OK || m != was_n || memcmp(now, was, was_n) != 0)
-            fz_fail("a refused snapshot changed the world's snapshot", NULL);
-        free(now);
-    }
-}
-
-static void fz_snapshot(fz_ctx *c)
-{
-    size_t n = 0, m = 0, i;
-    uint8_t *b, *again, *bad;
-    lc_world *x;
-    char err[256];
-    uint64_t h;
-    if (lc_world_save(c->w, NULL, 0, &n) != LC_OK) fz_fail("the snapshot's size query failed", lc_world_last_error(c->w));
-    b = malloc(n);
-    again = malloc(n);
-    bad = malloc(n);
-    if (b == NULL || again == NULL || bad == NULL) fz_fail("out of memory in the harness", NULL);
-    if (lc_world_save(c->w, b, n, &m) != LC_OK || m != n) fz_fail("lc_world_save failed", lc_world_last_error(c->w));
-    x = lc_world_create_from_snapshot(b, n, err, sizeof err);
-    if (x == NULL) fz_fail("the world's snapshot does not load", err);
-    if (lc_world_state_hash(x) != lc_world_state_hash(c->w)) fz_fail("a loaded snapshot has another state", NULL);
-    if (lc_world_save(x, again, n, &m) != LC_OK || m != n || memcmp(again, b, n) != 0)
-        fz_fail("a loaded snapshot saves other bytes", NULL);
-    lc_world_destroy(x);
-    h = fz_fnv1a(b, n);
-    for (i = 0; i < 12; ++i) {
-        size_t at = 32 + (size_t)((h + i * 7919u) % (n - 32));
-        memcpy(bad, b, n);
-        bad[at] ^= (uint8_t)(1u << ((h >> i) & 7u));
-        fz_fix_checksum(bad, n);
-        fz_load_or_refuse(c, bad, n, b, n);
-    }
-    fz_load_or_refuse(c, b, n - 1 - (size_t)(h % (n - 1)), b, n);
-    free(b);
-    free(again);
-    free(bad);
-}
-
 /* ---- entry point ----------------------------------------------------------------------------------- */
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
@@ -844,13 +763,13 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     }
     for (k = 0; k < MAX_COMMANDS && !fz_done(&in) && fz_may_step(&c); ++k) fz_command(&in, &c);
     if (c.steps == 0) fz_step(&in, &c); /* every input steps at least once */
-    fz_snapshot(&c);
+    fz_check_snapshot(c.w);
     lc_world_destroy(c.w);
 #ifdef FZ_REPLAY_MAIN
     {
         /* a regression for slowness carries its own bound on the input's whole work (the replayer sets
          * FZ_WORK_BOUND from fuzz/corpus/step-work-bounds.txt): the per-step bounds above are far above
-         * what such inputs do once fixed, so without it their regression could not fail */
+         * what such inputs do, so only their own bound catches their slowness coming back */
         const char *bound = getenv("FZ_WORK_BOUND");
         char msg[96];
         snprintf(msg, sizeof msg, "%llu units (bound %s)", c.work, bound ? bound : "none");

@@ -1,4 +1,4 @@
-"""Load on the sim node (issue 5, item 6): command flood, a subscriber that stops reading,
+"""Load on the sim node: command flood, a subscriber that stops reading,
 parameter spam, service spam. Loopback only (ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST), every loop
 bounded in time and count.
 

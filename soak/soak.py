@@ -1,4 +1,4 @@
-"""Bounded soak of the sim node at maximum speed while recording (issue 5, item 4).
+"""Bounded soak of the sim node at maximum speed while recording.
 
     source scripts/env.sh && export ROS_DOMAIN_ID=85
     nice python soak/soak.py --duration 3600 --out /tmp/soak1h      # the documented one-hour run

@@ -4,20 +4,19 @@ A base-12 pyramid (78 unit boxes, 1 kg, mu 0.6, e 0) on a static ground (e 0.5),
 5 kg unit box (e 0.5, mu 0.6) starts 2 m above the top at 8 m/s down, turning at 1 rad/s. It hits
 the pile in step 10. Each printed step shows its CPU time and the counters that explain it.
 
-What happens (session 6, docs/physics.md):
+What it shows (docs/physics.md):
 - Each impact involves the whole pile (~250-420 touches) and each of its time-of-impact searches
   re-integrates the whole pile, solving its frictional contact forces at every evaluation.
 - Those force solves do not converge: the normal/friction alternation of a large group crawls (a
-  ratio of ~0.97 a round) because the split of forces among a pile's touches is not unique, so every
-  solve spends its product budget (~2000 products instead of ~10-40 for a pile at rest).
-- Step 10 took 58 s and step 11 was undone after 288 s (the 50 000 serial impulse passes cap), so
-  the simulation could not go on. Later (sessions 6-8) step 12 was still undone at the cap.
-- Now (session 9, docs/physics.md) a group in motion is solved to 1e-4 of its fastest touch's speed
-  per step, never looser than 1e-3 g, and a large impact where nothing bounces goes straight to the
-  simultaneous inelastic solve: 80 steps in 383 s of CPU, none undone (the impact, steps 10-40, 70 s;
-  the pile's slow settling after it, steps 41-80, 313 s). The forces of the pile in motion still do
-  not converge (the residual printed is the alternation's last change, 1-100 m/s^2): a friction
-  solve that converges in a moving pile is open work.
+  ratio of ~0.97 a round) because the split of forces among a pile's touches is not unique. Solved
+  to the resting tolerance, every solve spends its product budget (~2000 products instead of ~10-40
+  for a pile at rest) and a step hits the 50 000 serial impulse passes cap and is undone.
+- That is why a group in motion is solved to 1e-4 of its fastest touch's speed per step, never
+  looser than 1e-3 g, and a large impact where nothing bounces goes straight to the simultaneous
+  inelastic solve: 80 steps in 383 s of CPU, none undone (the impact, steps 10-40, 70 s; the pile's
+  slow settling after it, steps 41-80, 313 s). The forces of the pile in motion do not converge
+  (the residual printed is the alternation's last change, 1-100 m/s^2): a friction solve that
+  converges in a moving pile is open work.
 
     source scripts/env.sh && python bench/repro/drop_into_pyramid.py [--steps 80] [--cpu 1500]
 

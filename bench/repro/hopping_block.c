@@ -1,9 +1,9 @@
 /* hopping_block.c - an upright 1 m x 0.5 m block (1 kg, e 0.8, mu 0.5) rocking from corner to corner
  * on a static floor while it drifts sideways: the state one block of the hard-case settling scene
- * (tests/c/test_hard_settle.c, sc_rng seed 1) had at 10 s, to 17 digits, in a run of that scene on an
- * engine variant since withdrawn (docs/physics.md "Time stepping").
- * Before friction was kept against a slipping point's slip it hopped on forever, gaining ~1.5e-4 J
- * per rock (docs/physics.md "Resting contact"); it should come to rest within a few steps.
+ * (tests/c/test_hard_settle.c, sc_rng seed 1) can reach at 10 s, to 17 digits (docs/physics.md
+ * "Time stepping"). It comes to rest within a few steps because friction is kept against a slipping
+ * point's slip (docs/physics.md "Resting contact"); a friction that is not hops on forever, gaining
+ * ~1.5e-4 J per rock.
  *
  *   cc -O2 -std=c99 -ffp-contract=off -Ilibcollide/include bench/repro/hopping_block.c build/libcollide.a -lm \
  *      -o /tmp/hopping_block && /tmp/hopping_block [vx vy omega angle y] [steps 600]

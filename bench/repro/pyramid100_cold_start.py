@@ -3,12 +3,11 @@
 Box2D's large_pyramid layout (unit boxes, 1 kg, mu 0.6, e 0, g 10, dt 1/60) on a ground box, exactly
 touching. Each step prints its CPU time and the counters that explain it (contact solves, products of
 the response matrix, the largest residual in m/s^2, TOI searches, collisions, projections).
-Until commit 48f383c the contact forces of the first step started from zero: MPRGP (sparse_lcp.c)
-stopped at its product budget 2 m/s^2 off, the drift set off 512 time-of-impact searches (22 s of CPU
-for step 1, step 2 unfinished after 14 minutes), and base 100 could not be benchmarked. Now a cold
-pile starts from the weights it carries (static_load.c): step 1 takes ~0.9 s, nearly all of it the
+A cold pile starts from the weights it carries (static_load.c): step 1 takes ~0.9 s, nearly all of it the
 projection that lifts the faces created at gap 0 to the contact gap, and the steps after ~0.04 s
-(docs/physics.md, "A cold pile starts from the weights it carries").
+(docs/physics.md, "A cold pile starts from the weights it carries"). Started from zero forces
+instead, MPRGP (sparse_lcp.c) stops at its product budget 2 m/s^2 off and the drift sets off 512
+time-of-impact searches (22 s of CPU for step 1, step 2 unfinished after 14 minutes).
 The script stops after --cpu seconds of CPU (default 120) or --steps steps (default 3), whichever
 comes first; a step in progress is not interrupted.
 

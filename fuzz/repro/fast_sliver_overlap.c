@@ -1,5 +1,7 @@
 /* libcollide: a 0.05 m x 2.4 m sliver (1e-9 kg, e = 1e-9) moving up at 1e6 m/s (allowed: |v| <= 1e8)
- * inside the walled box ends a 1 ms step overlapping the top wall by ~2 mm (found by fuzz_step). */
+ * inside the walled box, one 1 ms step (a fuzz_step regression input). Prints the sliver's vertices,
+ * which must end at or below the top wall's inner face y = 6 (the failure this guards against: the
+ * step ending ~2 mm inside the wall). */
 #include <math.h>
 #include <stdio.h>
 #include "collide/collide.h"

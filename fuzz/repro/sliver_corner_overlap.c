@@ -1,6 +1,8 @@
 /* libcollide: default settings, one 0.05 m x 0.716 m sliver (0.1 kg, e = 0, friction 0) thrown at
- * (-6.6, -10) m/s spinning at -5 rad/s into the bottom-left corner of the walled box; with dt = 0.044 s
- * it ends the third step ~0.3 mm inside the bottom wall (found by fuzz_step). Ordinary values. */
+ * (-6.6, -10) m/s spinning at -5 rad/s into the bottom-left corner of the walled box, dt = 0.044 s
+ * (a fuzz_step regression input, with ordinary values). Prints the lowest and leftmost vertex after
+ * each step: neither may pass the walls' inner faces at -6 (the failure this guards against: the
+ * third step ending ~0.3 mm inside the bottom wall). */
 #include <float.h>
 #include <math.h>
 #include <stdio.h>

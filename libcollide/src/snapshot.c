@@ -3,7 +3,7 @@
  *
  * Layout (every number little-endian, doubles as their IEEE-754 bits; docs/events_and_snapshots.md):
  *   header   8 bytes magic "LCWORLD\x1a", u32 format version, u32 0, u64 payload bytes,
- *            u64 FNV-1a 64 of the payload
+ *            u64 FNV-1a 64 of the payload (snapshot_checksum.h)
  *   payload  the world def field by field; time, the step's dt, the edit counters; the bodies in row
  *            order (id, state, mass properties, material, external force, shape, thrusters, regime
  *            mark); the springs; the last step's contacts; the counters; then what the engine keeps
@@ -27,11 +27,12 @@
 #include "contact_regime.h"
 #include "event_regime.h"
 #include "sleep.h"
+#include "snapshot_checksum.h"
 #include "snapshot_io.h"
 
 #define SNAP_MAGIC "LCWORLD\x1a"
 #define SNAP_VERSION 1u
-#define SNAP_HEADER 32u
+#define SNAP_HEADER LC_SNAPSHOT_HEADER_BYTES
 #define COUNTER_WORDS (sizeof(lc_counters) / 8)
 /* The largest body id a snapshot may hold: the id map takes an int per id up to the largest, so a corrupt
  * id could otherwise ask for gigabytes (2^28 ids: 1 GiB, the map of a world that created that many). */
@@ -40,17 +41,6 @@
 /* lc_counters is all 8-byte fields (uint64_t and double), written as words: one word per field on
  * every machine. */
 typedef char counters_are_words[sizeof(lc_counters) % 8 == 0 ? 1 : -1];
-
-static uint64_t fnv1a(const uint8_t *p, size_t n)
-{
-    uint64_t h = 1469598103934665603ULL;
-    size_t i;
-    for (i = 0; i < n; ++i) {
-        h ^= p[i];
-        h *= 1099511628211ULL;
-    }
-    return h;
-}
 
 /* ---- writing ----------------------------------------------------------------------------------- */
 
@@ -203,7 +193,7 @@ lc_status lc_world_save(const lc_world *w, void *buf, size_t capacity, size_t *o
     lc_put_u32(&o, SNAP_VERSION);
     lc_put_u32(&o, 0);
     lc_put_u64(&o, payload);
-    lc_put_u64(&o, fnv1a((const uint8_t *)buf + SNAP_HEADER, payload));
+    lc_put_u64(&o, lc_snapshot_checksum((const uint8_t *)buf, SNAP_HEADER + payload));
     ((lc_world *)w)->error[0] = '\0';
     return LC_OK;
 }
@@ -392,7 +382,7 @@ static lc_world *from_snapshot(const void *buf, size_t size, lc_status *st, char
                  size - SNAP_HEADER, (unsigned long long)payload);
         return NULL;
     }
-    if (fnv1a(p + SNAP_HEADER, (size_t)payload) != sum) {
+    if (lc_snapshot_checksum(p, size) != sum) {
         snprintf(why, why_len, "the snapshot's checksum does not match its contents (corrupt)");
         return NULL;
     }

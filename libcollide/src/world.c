@@ -15,6 +15,7 @@
 #include "contact_regime.h"
 #include "event_regime.h"
 #include "events.h"
+#include "snapshot_checksum.h"   /* lc_fnv1a64: the state hash is the snapshot checksum's hash */
 
 /* ---- scratch and errors ------------------------------------------------------------------ */
 
@@ -320,17 +321,9 @@ double lc_world_get_time(const lc_world *w) { return w ? w->time : 0.0; }
 
 uint64_t lc_world_state_hash(const lc_world *w)
 {
-    uint64_t h = 1469598103934665603ULL;
-    const unsigned char *p;
-    size_t i, n;
+    uint64_t h;
     if (w == NULL) return 0;
-    p = (const unsigned char *)&w->time;
-    for (i = 0; i < sizeof w->time; ++i) { h ^= p[i]; h *= 1099511628211ULL; }
-    p = (const unsigned char *)w->state;
-    n = (size_t)w->count * LC_STATE_SIZE * sizeof(double);
-    for (i = 0; i < n; ++i) { h ^= p[i]; h *= 1099511628211ULL; }
-    p = (const unsigned char *)w->ids;
-    n = (size_t)w->count * sizeof(lc_body_id);
-    for (i = 0; i < n; ++i) { h ^= p[i]; h *= 1099511628211ULL; }
-    return h;
+    h = lc_fnv1a64(LC_FNV1A64_BASIS, &w->time, sizeof w->time);
+    h = lc_fnv1a64(h, w->state, (size_t)w->count * LC_STATE_SIZE * sizeof(double));
+    return lc_fnv1a64(h, w->ids, (size_t)w->count * sizeof(lc_body_id));
 }

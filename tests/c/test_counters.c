@@ -24,7 +24,7 @@
  *     the change grows 138, and with the tolerance of a group in motion 94 (contact_forces.c), so
  *     the bound fails if that tolerance is lost (the counters are the same on every run).
  *     With lcp_exact_max = 2 (every group solved as a large one, by MPRGP): within 100 products
- *     per evaluation, where the resting tolerance in motion too cost 198 (now 50).
+ *     per evaluation (50 on this scene; the resting tolerance applied in motion too costs 198).
  * (7) a box dropped at 3 m/s onto a resting stack of four (e = 0, mu 0.6), with lcp_exact_max = 2 so
  *     that the impact's ~10 touches form a large group: no point bounces, so the impact takes no
  *     serial pass (impulse.c, the simultaneous inelastic solve at once), and the dropped box ends

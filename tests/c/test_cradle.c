@@ -8,8 +8,8 @@
  *   contacts, relative velocity 0 before, must not approach after), momentum u0 + 5 u1 = 5
  *   -> u1..u5 = 5/3 m/s, striker u0 = -10/3 m/s (impulses 25/3, 20/3, 5, 10/3, 5/3 > 0, so the
  *   guess is the LCP solution); kinetic energy (100/9 + 5 * 25/9)/2 = 12.5 J is conserved too.
- * Tolerances: velocities 1e-6 m/s (the issue's figure: serial passes stop once no contact
- * approaches faster than a small threshold; exact two-body e = 1 swaps are round-off);
+ * Tolerances: velocities 1e-6 m/s (serial passes stop once no contact approaches
+ * faster than a small threshold; exact two-body e = 1 swaps are round-off);
  * energy 1e-6 relative (a 1e-6 m/s residual on a 5 m/s body is 5e-6 J of 12.5 J);
  * momentum 1e-12 relative (equal and opposite impulses: round-off only). */
 #include "check.h"

@@ -1,7 +1,7 @@
 /* test_energy_box: six 1 m x 3 m blocks (the seed's) in the walled box [-6,6] x [-6,6], e = 1,
  * damping 0, g = 0, fixed-seed random velocities (|v| up to ~4 m/s, |omega| up to 1.5 rad/s),
  * stepped 100 s at dt = 0.01 s. Every impact is elastic and nothing else does work, so the total
- * energy must stay constant. Tolerance: 1e-6 relative (the issue's requirement). Each impact
+ * energy must stay constant. Tolerance: 1e-6 relative (the project's requirement). Each impact
  * changes the energy only by round-off and by the timing of the impact (the engine's TOI
  * tolerance 1e-10 s; the impulse itself conserves energy at e = 1 for any geometry), free flight
  * is exact up to round-off, so hundreds of impacts stay far below 1e-6. Printed: the reached

@@ -67,7 +67,7 @@ static void drop(lc_impact_mode mode)
 
 int main(void)
 {
-    drop(LC_IMPACT_SERIAL);       /* the default, the case the issue names */
+    drop(LC_IMPACT_SERIAL);       /* the default impact model */
     drop(LC_IMPACT_SIMULTANEOUS); /* symmetric LCP: equal impulses at both corners */
     return CHECK_SUMMARY("test_flat_drop");
 }

@@ -1,4 +1,4 @@
-/* test_hard_common.h - the per-step monitor shared by the hard-case stability suite (issue 4,
+/* test_hard_common.h - the per-step monitor shared by the hard-case stability suite (docs/hard_cases.md,
  * tests/c/test_hard_*.c). Header only, C99, include after check.h and scenes.h.
  *
  * A monitor (hc_mon) watches one world while the test steps it with hc_step():

@@ -1,12 +1,12 @@
-/* test_hard_cradle: issue 4 hard case with an exact answer, run for 60 s at dt = 1/60 s, e = 1, no
+/* test_hard_cradle (docs/hard_cases.md): an exact answer, run for 60 s at dt = 1/60 s, e = 1, no
  * friction, no damping, every other setting the engine's default (serial impacts).
  * (5) Newton's cradle in a walled channel (g = 0): a 1 m x 0.5 m 1 kg striker at 5 m/s into five
  *     such blocks 5 cm apart, and into five such blocks with end faces touching; the channel's walls
  *     (inner faces x = -1.5 and x = 9) send the outgoing block back, so the chain runs back and forth ~40 times.
  *     Exact (sequential e = 1 exchanges between equal masses, face-on): at every step end exactly
  *     one block moves, at |vx| = 5 m/s, the others are at rest; no vy, no spin; the blocks keep
- *     their order. Tolerances: speeds 1e-6 m/s (the issue's cradle figure: serial passes stop once no
- *     contact approaches faster than a small threshold), vy and omega 1e-9 (symmetric two-point
+ *     their order. Tolerances: speeds 1e-6 m/s (serial passes stop once no contact approaches
+ *     faster than a small threshold), vy and omega 1e-9 (symmetric two-point
  *     impulses: round-off only), kinetic energy 12.5 J to 1e-9 relative, |px| = 5 kg m/s to 1e-6.
  *
  *
@@ -88,9 +88,10 @@ int main(void)
 {
     cradle(0.05, "cradle, 5 cm gaps");
     /* Touching: each exchange is a simultaneous impact of the whole row, resolved by serial passes
-     * into the sequential answer. After the row breaks up, blocks that part slowly after an impact
-     * while their rotation turns them back used to be held by contact forces that gained 4.8e-8 J
-     * (3.8e-9 of E0); separating touches now go free (event_touches.c, lc_event_resting): -1.7e-9 J. */
+     * into the sequential answer. After the row breaks up, blocks part slowly after an impact while
+     * their rotation turns them back; a separating touch goes free (event_touches.c, lc_event_resting)
+     * rather than being held by contact forces, which would add energy (4.8e-8 J, 3.8e-9 of E0, here;
+     * measured -1.7e-9 J as it is). */
     cradle(0.0, "cradle, touching");
     return CHECK_SUMMARY("test_hard_cradle");
 }

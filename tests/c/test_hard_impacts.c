@@ -1,4 +1,4 @@
-/* test_hard_impacts: issue 4 hard cases with exact answers (the cradle is in pending/test_hard_cradle.c), run for 60 s at dt = 1/60 s, e = 1, no
+/* test_hard_impacts: hard cases (docs/hard_cases.md) with exact answers (the cradle is test_hard_cradle.c), run for 60 s at dt = 1/60 s, e = 1, no
  * friction, no damping, every other setting the engine's default (serial impacts).
  * (6) a small fast block against a thin wall, repeatedly: a 0.1 m x 0.1 m 0.1 kg block in the left
  *     half of a walled 10 m x 6 m box split by a static wall 0.05 m thick (x in [-0.025, 0.025],

@@ -1,4 +1,4 @@
-/* test_hard_pyramid: issue 4 hard case (4), Box2D's "large pyramid" layout with base 20 (210 unit
+/* test_hard_pyramid (docs/hard_cases.md): Box2D's "large pyramid" layout with base 20 (210 unit
  * boxes, 1 m x 1 m, 1 kg; row i at y = 0.5 + i, box j of it at x = (i + 1)/2 + (j - i) - base/2, all
  * faces touching) on a static ground box 60 m x 1 m (top face y = 0), g = 10 m/s^2 (Box2D's), e = 0,
  * friction mu = 0.6 on every body and, second case, frictionless (every contact normal is vertical

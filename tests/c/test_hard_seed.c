@@ -1,4 +1,4 @@
-/* test_hard_seed: issue 4 hard case (1), the seed scene run long. 6 and 20 blocks 1 m x 0.5 m, 1 kg,
+/* test_hard_seed: the seed scene run long (docs/hard_cases.md). 6 and 20 blocks 1 m x 0.5 m, 1 kg,
  * in a walled 10 m x 10 m box (inner faces [0,10]^2, walls 1 m thick), placed on random cells of a
  * 2 m grid with random angle in [0, pi), v in [-3, 3]^2 m/s and omega in [-2, 2] rad/s (the layout
  * of bench/scenes.py seed(), here from sc_rng with a fixed seed); e = 1, no friction, no damping,
@@ -11,7 +11,7 @@
  *    approach slower than resting_speed = 1e-4 m/s is treated as resting, not bounced, which can
  *    remove at most m v^2 / 2 = 5e-9 J per event, and the drift correction may lift a body by at most
  *    contact_distance = 1e-5 m; neither happens in these flying scenes. Tolerance: |E - E0| <= 1e-9 E0
- *    at every step, both ways - the issue's target for this scene (10 s), kept for 60 s: round-off
+ *    at every step, both ways - the project's target for this scene (10 s), kept for 60 s: round-off
  *    over 3600 steps and ~1e4 impacts is ~1e-16 * 1e4 * a few ~ 1e-12 (measured 5e-15), while any
  *    modelling error - one impact resolved inelastically, a mistimed TOI under gravity, a resting
  *    band event at 1e-4 m/s - costs >= 5e-9 J, i.e. well above 1e-9 E0 only for the first two;

@@ -1,4 +1,4 @@
-/* test_hard_settle: issue 4 hard cases (2) settling and (8) a block wedged between two walls, 60 s at
+/* test_hard_settle (docs/hard_cases.md): (2) settling and (8) a block wedged between two walls, 60 s at
  * dt = 1/60 s, g = 9.8 m/s^2, every other setting the engine's default.
  * (2) the seed scene's 20 blocks (layout of test_hard_seed, sc_rng seed 1) with e = 0.8 and mu = 0.5
  *     (bench settling()): the blocks lose energy at every impact and must come to

@@ -1,4 +1,4 @@
-/* test_hard_stacks: issue 4 hard cases (3) vertical stacks and (7) the 1:1000 mass-ratio stack, run
+/* test_hard_stacks (docs/hard_cases.md): (3) vertical stacks and (7) the 1:1000 mass-ratio stack, run
  * for 60 s at dt = 1/60 s, g = 9.8 m/s^2, every other setting the engine's default.
  * Layout (bench/scenes.py stack() and mass_ratio_stack()): blocks 1 m wide x 0.5 m tall, centred
  * on x = 0, faces exactly touching (gap 0), the lowest on a static floor 20 m x 1 m whose top face
@@ -8,10 +8,10 @@
  * normal is vertical, friction is never needed); 1 kg under 1000 kg and 1000 kg under 1 kg.
  * Asserted at every step end (besides test_hard_common.h's LC_OK / clock / finite / in box / overlap
  * <= 1e-9 m):
- *  - sink and rise of the top block |y - y0| <= 1e-5 m (the issue's target "sink < 0.01 mm"; the
+ *  - sink and rise of the top block |y - y0| <= 1e-5 m (the project's target "sink < 0.01 mm"; the
  *    engine holds contacts at gap contact_gap = 1e-7 m, so a stack of 20 may rise by 20 * 1e-7 =
  *    2e-6 m when its faces move from gap 0 to the held gap; Box2D v3 sinks 43 / 180 mm here);
- *  - sideways creep |x - x0| <= 1e-5 m for every block (the issue's "< 0.01 mm"; exact answer 0);
+ *  - sideways creep |x - x0| <= 1e-5 m for every block (the target's "< 0.01 mm"; exact answer 0);
  *  - tilt <= 1e-5 rad for every block (a 1 m face tilted by 1e-5 rad lifts a corner by
  *    contact_distance = 1e-5 m, i.e. off the contact);
  *  - at rest: |v| <= 1e-6 m/s and |omega| <= 1e-6 rad/s for every block at every step end (no jitter,

@@ -251,9 +251,9 @@ int main(void)
     wall_case(0.0, 0.7, LC_TOI_ROOT_FINDER);
     wall_case(0.8, 1.0, LC_TOI_ROOT_FINDER);
     it_root = wall_case(0.8, 0.7, LC_TOI_ROOT_FINDER);
-    /* The seed's bisection reaches the same impact to the same tolerances, with more gap
+    /* Bisection (LC_TOI_BINARY_SEARCH) reaches the same impact to the same tolerances, with more gap
      * evaluations: halving a 0.01 s step down to 1e-10 s takes ~27 of them, while the root finder
-     * converges superlinearly (the issue asks for "few evaluations"). */
+     * converges superlinearly, so it needs few. */
     wall_case(0.0, 0.7, LC_TOI_BINARY_SEARCH);
     it_bisect = wall_case(0.8, 0.7, LC_TOI_BINARY_SEARCH);
     CHECK(it_root < it_bisect, "root finder used %llu gap evaluations, bisection %llu", (unsigned long long)it_root,

@@ -1,5 +1,5 @@
-/* test_pile: blocks settling onto each other under gravity with e < 1 -- the seed's "stuck" case
- * in its general form (issue 2: "the seed's stuck cases ... never get stuck"). Kept apart from
+/* test_pile: blocks settling onto each other under gravity with e < 1 -- the seed scene's piles in
+ * their general form, which must come to rest and never get stuck. Kept apart from
  * test_resting so a regression here (a step that never returns) is visible as its own ctest.
  * Scenes:
  *  (1) the seed's six 1 x 3 m blocks in the box [-6,6]^2 with fixed-seed random velocities,

@@ -13,9 +13,9 @@
  *  (3) a block on the floor sliding flat into a wall (see into_wall);
  *  (4) a 1 kg block resting on the floor pushed along it by a 100 N thruster through its centre for
  *      0.25 s: every step succeeds and vx = F t / m to 1e-9 m/s (a constant force without friction:
- *      RK4 is exact), vy stays 0. The per-interval energy check of the contact forces once took the
- *      thruster's work (1.4 J in the first step, more than the block's kinetic energy plus 1 J) for
- *      a blow-up and failed the first step. */
+ *      RK4 is exact), vy stays 0. The thruster's work (1.4 J in the first step, more than the block's
+ *      kinetic energy plus 1 J) is work of an applied force, which the per-interval energy check of
+ *      the contact forces must not take for a blow-up. */
 #include "check.h"
 #include "scenes.h"
 

@@ -18,6 +18,7 @@
 #include <stdlib.h>
 #include "check.h"
 #include "scenes.h"
+#include "snapshot_checksum.h"
 
 /* ---- helpers ---------------------------------------------------------------------------------- */
 
@@ -41,25 +42,6 @@ static blob save(const lc_world *w)
 }
 
 static int same_blob(blob a, blob b) { return a.n == b.n && memcmp(a.p, b.p, a.n) == 0; }
-
-static uint64_t fnv1a(const unsigned char *p, size_t n)
-{
-    uint64_t h = 1469598103934665603ULL;
-    size_t i;
-    for (i = 0; i < n; ++i) {
-        h ^= p[i];
-        h *= 1099511628211ULL;
-    }
-    return h;
-}
-
-/* The header's checksum (bytes 24..31, little-endian) made right for the payload from byte 32. */
-static void fix_checksum(unsigned char *p, size_t n)
-{
-    uint64_t h = fnv1a(p + 32, n - 32);
-    int k;
-    for (k = 0; k < 8; ++k) p[24 + k] = (unsigned char)(h >> (8 * k));
-}
 
 typedef lc_world *(*builder)(void);
 
@@ -364,7 +346,7 @@ static void corrupt_input(void)
         lc_status s;
         memcpy(c, b.p, b.n);
         c[i] ^= (unsigned char)(0x80u >> (i % 8));
-        fix_checksum(c, b.n);
+        lc_snapshot_set_checksum(c, b.n);
         s = lc_world_load(w, c, b.n);
         if (s == LC_OK) {
             accepted++;
@@ -398,7 +380,7 @@ static void corrupt_input(void)
             longer[b.n] = 0;
             refused(w, &was, longer, b.n + 1, LC_ERR_BAD_SNAPSHOT, "a byte more than the header says", "truncated");
             longer[16] = (unsigned char)(longer[16] + 1);   /* the payload size follows, the checksum does not */
-            fix_checksum(longer, b.n + 1);
+            lc_snapshot_set_checksum(longer, b.n + 1);
             refused(w, &was, longer, b.n + 1, LC_ERR_BAD_SNAPSHOT, "a trailing byte", "follow");
             free(longer);
         }
@@ -442,9 +424,30 @@ static void header_layout(void)
         sum |= (uint64_t)b.p[24 + k] << (8 * k);
     }
     CHECK(payload == b.n - 32, "payload size %llu of %zu bytes", (unsigned long long)payload, b.n);
-    CHECK(sum == fnv1a(b.p + 32, b.n - 32), "%s", "checksum");
+    CHECK(sum == lc_snapshot_checksum(b.p, b.n), "%s", "checksum");
     free(b.p);
     lc_world_destroy(w);
+}
+
+/* The checksum's bits are part of snapshot format 1 (snapshot_checksum.h): FNV-1a 64 with this library's
+ * offset basis, little-endian at bytes 24..31, over the payload only. header_layout compares a saved
+ * header with lc_snapshot_checksum; this pins lc_snapshot_checksum itself to values worked out by hand
+ * (python: h ^= byte; h = h * 1099511628211 % 2**64, from 1469598103934665603), so a changed hash
+ * fails here instead of silently moving the format. */
+static void checksum_pinned(void)
+{
+    unsigned char s[40];
+    int k, others = 1;
+    memset(s, 0xA5, 32);                  /* a header whose bytes the checksum must not read */
+    memcpy(s + 32, "LCWORLD\x1a", 8);     /* a payload */
+    CHECK(lc_snapshot_checksum(s, 32) == 0x14650fb0739d0383ULL, "%s", "an empty payload hashes to the offset basis");
+    CHECK(lc_snapshot_checksum(s, 40) == 0x6b7ca17ec82567f4ULL, "checksum %016llx",
+          (unsigned long long)lc_snapshot_checksum(s, 40));
+    lc_snapshot_set_checksum(s, 40);
+    for (k = 0; k < 8; ++k)
+        CHECK(s[24 + k] == (unsigned char)(0x6b7ca17ec82567f4ULL >> (8 * k)), "checksum byte %d little-endian", k);
+    for (k = 0; k < 24; ++k) others &= s[k] == 0xA5;
+    CHECK(others && memcmp(s + 32, "LCWORLD\x1a", 8) == 0, "%s", "setting the checksum writes bytes 24..31 only");
 }
 
 int main(void)
@@ -453,5 +456,6 @@ int main(void)
     saved_asleep();
     corrupt_input();
     header_layout();
+    checksum_pinned();
     return CHECK_SUMMARY("test_snapshot");
 }

@@ -1,4 +1,4 @@
-"""Bad-input catalogue (issue 5, item 1): the gaps left by test_api_errors.c, test_binding.py,
+"""Bad-input catalogue: the gaps left by test_api_errors.c, test_binding.py,
 test_scene.py, test_runner.py and test_node*.py. Every case asserts the error (type and text) and
 that the state is unchanged: for the library the state hash, names and spring count; for the
 runner that nothing was written; for the node that the other bodies did not move, sim time kept

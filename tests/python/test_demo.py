@@ -43,7 +43,7 @@ def test_summary(demo: tuple[Path, str]) -> None:
     assert "demo: live view: open http://127.0.0.1:" in stdout  # the live view ran next to the node
     s = json.loads((out / "demo_summary.json").read_text())
     # e = 1, no damping, no gravity and no command in the coast: the engine's event-accurate
-    # impacts keep energy to round-off (~1e-15); 1e-9 is the project's target (issue 2)
+    # impacts keep energy to round-off (~1e-15); 1e-9 is the project's target
     assert s["energy_drift_rel"] < 1e-9 and s["coast_seconds"] > 2.0 and s["coast_energy_J"] > 0.1
     assert s["real_time_factor"] > 0.0 and s["sim_seconds"] > 9.9
     # the push sends block1 across the 12 m box at > 1 m/s: at least one impact in 10 s, reported

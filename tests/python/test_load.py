@@ -1,4 +1,4 @@
-"""Load (issue 5, item 6): soak/load.py against one node at real_time_factor 1, 4 s per phase.
+"""Load: soak/load.py against one node at real_time_factor 1, 4 s per phase.
 
 Phases: 10 kHz WrenchStamped flood on block1/thrust, a reliable subscriber to every topic that is
 SIGSTOPped (stops reading) and then killed, set/get_parameters spam (accepted, out-of-range,

@@ -1,6 +1,6 @@
 """The node's ``contacts`` message, written as CDR bytes by ``cdr.ContactsCdr``, carries exactly
-what the Python object path it replaced carried (one ``Contact`` per kept row, serialized by rclpy;
-the function below is that code as it was in the node).
+what a Python object path carries (one ``Contact`` per kept row, serialized by rclpy; the function
+below is that reference).
 
 One in-process node (no executor, no subscribers) runs the node bench's pile: 200 boxes dropped
 with friction (bench/node_bench.py, pile_scene). Its publishes are recorded with the rows
@@ -172,7 +172,7 @@ def test_cdr_contacts_equal_the_object_path(run: tuple[list[Published], int]) ->
         assert len(have) == len(want) and not np.any(have[have != want]), f"message {i}"
     names = [c.body_a for p in log for c in deserialize_message(p.raw, Contacts).contacts
              if killed not in p.names and killed in p.rows["body_a"]]
-    assert str(killed) in names  # the former object path's name for an id the node no longer knows
+    assert str(killed) in names  # the object path's name for an id the node no longer knows
 
 
 def test_concat_rows_equals_numpy_concatenate() -> None:

@@ -137,7 +137,7 @@ def test_a_normal_step_is_worth_splitting(sim: SimNode) -> None:
 
 def _fast_spinner(sim: SimNode) -> None:
     # block1 at ~1e5 m/s and 1e5 rad/s among three blocks under gravity: absurd, but a state the
-    # API accepts. Found by hand (2026-11-24): C undoes its step at t = 1.192 s (the whole-step energy
+    # API accepts, in which C undoes its step at t = 1.192 s (the whole-step energy
     # balance: "gained far more energy than its external forces ... can give") and the same step
     # goes through as five parts (1/2, 1/4, ... of the step).
     for _ in range(10):
@@ -157,7 +157,7 @@ def test_a_step_c_undoes_goes_through_in_parts(sim: SimNode) -> None:
 
 @pytest.mark.parametrize("sim", [{"blocks": 4, "gravity": 9.8}], indirect=True)
 def test_without_parts_the_same_step_fails_again_and_again(sim: SimNode) -> None:
-    # the node before the split (session 18): the undone step was retried as it was
+    # a node that only retries: the undone step is tried again unchanged, and fails again
     _fast_spinner(sim)
     sim._worth_splitting = lambda: False  # type: ignore[method-assign]
     ok = [sim.step_once() for _ in range(1500)]

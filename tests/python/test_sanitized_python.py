@@ -1,5 +1,5 @@
 """The Python binding and node tests against an AddressSanitizer + UndefinedBehaviorSanitizer build of
-libcollide (issue 5, item 3).
+libcollide.
 
 A sanitizer build of the library (gcc, -O1 -fsanitize=address,undefined -fno-sanitize-recover=all)
 is made once per source state in build/sanitizer-python/ (a hash of the sources is its stamp). The

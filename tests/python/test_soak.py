@@ -23,10 +23,10 @@ DURATION = 150.0  # wall seconds: ~3e6 steps, ~10 resets, ~75 parameter sets, ~6
 def test_short_soak(tmp_path: Path) -> None:
     # RSS rises in steps during the first minute (with set_parameters over the wire; see
     # docs/hardening.md, "Soak"), so the short run judges memory over its second half only.
-    # state_rate 5 Hz of sim time: at real_time_factor 0 the message rate grows with the engine's speed
-    # (session 2 made it 1.5-1.7x faster); at 10 Hz the Python recorder fell behind in the full suite
-    # on a 2-core machine and lost 46 of 33 763 poses (reliable KEEP_LAST: the writer's history
-    # overflowed), which is the recorder's throughput, not a loss this test is meant to find
+    # state_rate 5 Hz of sim time: at real_time_factor 0 the message rate grows with the engine's speed;
+    # at 10 Hz the Python recorder falls behind in the full suite on a 2-core machine (46 of 33 763
+    # poses lost in one run: reliable KEEP_LAST, the writer's history overflows), which is the
+    # recorder's throughput, not a loss this test is meant to find
     res = run_soak(DURATION, tmp_path / "soak", seed=5, state_rate=5.0, reset_every=15.0, warmup=0.5,
                    log=lambda s: None)
     # it really ran: sim time advanced far beyond wall time (RTF 0), commands went out
