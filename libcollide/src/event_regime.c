@@ -68,14 +68,35 @@ void lc_event_regime_rows_shifted(lc_event_regime *er) { lc_event_touches_rows_s
 
 void lc_event_regime_forget_end(lc_event_regime *er) { lc_event_touches_forget_end(er->touches); }
 
+/* 1 if every row moves in closed form (constant applied forces; no touch: the caller's). */
+static int rows_closed_form(const lc_world *w, const int *rows, int nrows)
+{
+    int i;
+    for (i = 0; i < nrows; ++i)
+        if (!lc_body_forces_constant(w, rows[i])) return 0;
+    return 1;
+}
+
+static lc_status event_advance(lc_world *w, lc_event_regime *er, const lc_step_try *step, double dt, double t0,
+                               const int *event_rows, int nrows, int *marks_known, int *handover, double *t_handover);
+
 lc_status lc_event_advance(lc_world *w, lc_event_regime *er, const lc_step_try *step, double dt, double t0,
                            const int *event_rows, int nrows, int *marks_known, int *handover, double *t_handover)
+{
+    lc_status st = event_advance(w, er, step, dt, t0, event_rows, nrows, marks_known, handover, t_handover);
+    lc_broad_phase_untrack(w);   /* the tracked reach describes this pass's trial only */
+    return st;
+}
+
+static lc_status event_advance(lc_world *w, lc_event_regime *er, const lc_step_try *step, double dt, double t0,
+                               const int *event_rows, int nrows, int *marks_known, int *handover, double *t_handover)
 {
     size_t bytes;
     double *s0, *s1, *scratch, remaining;
     int *rows, i, events = 0, nstalled = 0, nrest = 0, passes = 0, persisting = -1, last_impact_body = -1;
     int dissipative_events = 0;
-    int *drows, ndirty = 0, local_next = 0, body_springs = 0, started_deep = 0;
+    int *drows, ndirty = 0, local_next = 0, body_springs = 0, started_deep = 0, islands_alone = 0;
+    int tracked = 0, may_track = 0;
     uint8_t *dirty;
     double last_tmin = 0.0, trial_left = 0.0, ts;
     lc_crossing stalled[LC_MAX_STALLED];
@@ -178,6 +199,23 @@ lc_status lc_event_advance(lc_world *w, lc_event_regime *er, const lc_step_try *
                     return lc_step_undo(w, step, LC_ERR_NUMERIC,
                                         "integration produced a non-finite state (forces too stiff for dt?)");
         }
+        /* A trial interval's first impact is followed by local passes (above): from the first of them on,
+         * where every body can be until the interval ends is tracked in a grid, and each impact's bodies
+         * only are moved in it; their pairs and impact groups are then found among what is near them,
+         * not among every body. Free flight only: a body in closed form stays on its path. */
+        if (!local) {
+            lc_broad_phase_untrack(w);
+            tracked = 0;
+            may_track = nrest == 0 && !body_springs;
+        } else if (tracked) {
+            if (lc_broad_phase_retrack(w, s0, s1, trial, drows, ndirty, w->def.contact_distance) != 0) goto oom;
+        } else if (may_track) {
+            may_track = 0;
+            if (rows_closed_form(w, rows, nrows)) {
+                if (lc_broad_phase_track(w, s0, s1, trial, rows, nrows, w->def.contact_distance) != 0) goto oom;
+                tracked = 1;
+            }
+        }
         if (nrest > 0) {
             uint8_t *mark = lc_buf_get(&er->marks, (size_t)w->count);
             if (mark == NULL) goto oom;
@@ -214,7 +252,11 @@ lc_status lc_event_advance(lc_world *w, lc_event_regime *er, const lc_step_try *
          * the best time so far are kept for the next crossing of the same islands (a pile is one
          * island, and each of its integrations solves the whole pile's contact forces). */
         ts = lc_stage_begin(w);
-        if (nc > 0 && lc_touch_islands_build(w, er->islands, rows, nrows, rest, nrest) != 0) goto oom;
+        /* a local pass has no resting touch and no spring between bodies: the islands of the last build
+         * without touches are still every row on its own */
+        if (nc > 0 && !(local && islands_alone) && lc_touch_islands_build(w, er->islands, rows, nrows, rest, nrest) != 0)
+            goto oom;
+        if (nc > 0) islands_alone = nrest == 0 && !body_springs;
         {
             double *at_best = NULL, at_t = -1.0;
             int at_ia = -2, at_ib = -2;
@@ -229,11 +271,15 @@ lc_status lc_event_advance(lc_world *w, lc_event_regime *er, const lc_step_try *
                     int ia = lc_touch_island(er->islands, cross[i].a), ib = lc_touch_island(er->islands, cross[i].b);
                     if (at_best == NULL && (at_best = lc_buf_get(&er->at_best, bytes)) == NULL) goto oom;
                     if (at_t != tmin || at_ia != ia || at_ib != ib) {
-                        if (lc_integrate(w, s0, tmin, erows, nerows, erest, nerest, at_best) != 0) goto oom;
+                        /* the two islands' rows only: every crossing read here has its bodies in them,
+                         * or static (copied below) */
+                        if (lc_integrate_rows(w, s0, tmin, erows, nerows, erest, nerest, at_best) != 0) goto oom;
                         at_t = tmin;
                         at_ia = ia;
                         at_ib = ib;
                     }
+                    if (w->is_static[cross[i].a]) memcpy(&at_best[cross[i].a * 6], &s0[cross[i].a * 6], 6 * sizeof(double));
+                    if (w->is_static[cross[i].b]) memcpy(&at_best[cross[i].b * 6], &s0[cross[i].b * 6], 6 * sizeof(double));
                     g = lc_vertex_edge_gap(w, at_best, cross[i].a, cross[i].vertex, cross[i].b, cross[i].edge);
                     if (g > w->def.contact_gap) continue;
                 }

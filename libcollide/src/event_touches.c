@@ -267,10 +267,25 @@ int lc_event_impact_group(lc_world *w, lc_event_touches *et, const double *state
     if (!w->is_static[c->a]) { seen[c->a] = 1; queue[nq++] = c->a; }
     if (!w->is_static[c->b]) { seen[c->b] = 1; queue[nq++] = c->b; }
     for (q = 0; q < nq; ++q) {
-        int body = queue[q];
-        for (k = 0; k < w->count; ++k) {
+        int body = queue[q], m, j;
+        const int *near = NULL;
+        /* while the broad phase tracks the trial (free flight), only the bodies whose reach meets this
+         * one's circle grown by contact_distance can pass the distance test below: the same bodies in
+         * the same order, without visiting every body */
+        {
+            double qb[4], rq = w->shape[body].radius + w->def.contact_distance;
+            qb[0] = state[body * 6 + SX] - rq;
+            qb[1] = state[body * 6 + SY] - rq;
+            qb[2] = state[body * 6 + SX] + rq;
+            qb[3] = state[body * 6 + SY] + rq;
+            m = lc_broad_phase_near(w, qb, &near);
+            if (m == -1) return -1;
+            if (m < 0) m = w->count;
+        }
+        for (j = 0; j < m; ++j) {
             double dx, dy, r;
             int before = n;
+            k = near != NULL ? near[j] : j;
             if (k == body || seen[k] == 2) continue;   /* a pair with a finished body was collected */
             if (w->excluded && w->excluded[k]) continue;   /* another island's */
             dx = state[body * 6 + SX] - state[k * 6 + SX];
