@@ -254,8 +254,11 @@ static int pairs_of(lc_world *w, box *boxes, lc_buf *buf)
         if (sorted == NULL) return -1;
         w->last.sort_and_sweep_steps++;
         for (i = 0; i < n; ++i)
-            for (j = i + 1; j < n && sorted[j].x0 <= sorted[i].x1; ++j)
+            for (j = i + 1; j < n && sorted[j].x0 <= sorted[i].x1; ++j) {
+                /* most boxes in the x band lie above or below (a wide world holds ~sqrt(n) in a band) */
+                if (sorted[j].y0 > sorted[i].y1 || sorted[i].y0 > sorted[j].y1) continue;
                 if ((count = add_if_near(w, buf, count, &sorted[i], &sorted[j])) < 0) return -1;
+            }
         /* same pair order as brute force, so results do not depend on the broadphase */
         if (count > 1 && order_pairs(w, (int *)buf->p, count) != 0) return -1;
     }

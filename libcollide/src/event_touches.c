@@ -255,7 +255,7 @@ int lc_event_keep_warm(lc_event_touches *et, const lc_touch *t, int n)
  * When the time came from the pair's separation (by_pair), the crossing's vertex need not be the one
  * touching: the pair's touches are its separating-axis manifold alone. */
 int lc_event_impact_group(lc_world *w, lc_event_touches *et, const double *state, const lc_crossing *c, int by_pair,
-                          lc_touch **out)
+                          lc_touch **out, int (*sync)(void *ctx, int row), void *ctx)
 {
     int *queue = lc_buf_get(&et->group, (size_t)w->count * (sizeof(int) + 1));
     uint8_t *seen;   /* 1 queued, 2 done */
@@ -287,6 +287,8 @@ int lc_event_impact_group(lc_world *w, lc_event_touches *et, const double *state
             int before = n;
             k = near != NULL ? near[j] : j;
             if (k == body || seen[k] == 2) continue;   /* a pair with a finished body was collected */
+            /* a body whose clock lags (event_regime.c) is brought to the impact's time first */
+            if (near != NULL && sync != NULL && sync(ctx, k) != 0) return -1;
             if (w->excluded && w->excluded[k]) continue;   /* another island's */
             dx = state[body * 6 + SX] - state[k * 6 + SX];
             dy = state[body * 6 + SY] - state[k * 6 + SY];
