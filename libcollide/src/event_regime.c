@@ -284,7 +284,7 @@ static lc_status event_advance(lc_world *w, lc_event_regime *er, const lc_step_t
         if (!local) {
             lc_broad_phase_untrack(w);
             tracked = 0;
-            may_track = nrest == 0 && !body_springs;
+            may_track = nrest == 0 && !body_springs && nrows >= LC_TRACK_MIN_ROWS;
         } else if (tracked) {
             if (lc_broad_phase_retrack(w, s0, s1, trial, drows, ndirty, w->def.contact_distance) != 0) goto oom;
         } else if (may_track) {
