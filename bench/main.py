@@ -329,10 +329,14 @@ class Bench:
             ns += [2000]
         if self.full:
             ns += [5000]
+        if self.args.scaling_n:
+            ns = [int(x) for x in self.args.scaling_n.split(",")]
         # n = 0: one static box only, i.e. the per-step floor of each engine and its Python binding
         empty = scenes.Scene("many0", (scenes.Box(1.0, 1.0, 0.0, 0.0, static=True),), duration=10.0)
-        tasks = [Task(eng, empty, 1 / 60, {}, None, self.budget) for eng in ALL]
-        tasks += [Task(eng, scenes.many(n), 1 / 60, {}, None, self.budget) for n in ns for eng in ALL]
+        engs = ALL if not self.args.engines else \
+            ("libcollide",) + tuple(e for e in PEERS if e in self.args.engines.split(","))
+        tasks = [Task(eng, empty, 1 / 60, {}, None, self.budget) for eng in engs]
+        tasks += [Task(eng, scenes.many(n), 1 / 60, {}, None, self.budget) for n in ns for eng in engs]
         log(f"scaling: {len(tasks)} runs")
         res = self.run(tasks)
         rows = []
@@ -366,6 +370,9 @@ def main() -> int:
     ap.add_argument("--budget", type=float, help="CPU seconds per run before it is stopped (default 15, quick 4, "
                     "full 60; contact: libcollide runs only, default 60, quick 20)")
     ap.add_argument("--no-report", action="store_true", help="only write bench/results/latest.json")
+    ap.add_argument("--scaling-n", help="comma list of body counts for the scaling section (e.g. 100,500,2000,5000,20000) "
+                    "instead of its default list")
+    ap.add_argument("--engines", help="comma list of engines for the scaling section (default: all; libcollide always)")
     args = ap.parse_args()
     t0 = time.time()
     b = Bench(args)

@@ -631,10 +631,10 @@ def write(out: dict[str, Any], path: str, img_dir: str) -> None:
             a, b = sc_rows[0], sc_rows[-1]
             def adv(r: dict[str, Any]) -> float:
                 return r["stages"]["analytic_advances"] / max(r["stages"]["steps"], 1) / r["n"]
-            L.append(f"- Scaling: body advances per body per step grow from {adv(a):.3g} ({a['n']} bodies) to "
-                     f"{adv(b):.3g} ({b['n']} bodies) — each impact event moves every body to the event time, so a "
-                     f"step costs about bodies × (impacts per step + 1) advances, quadratic in the body count at "
-                     f"constant crowding; the peers' cost per body stays flat.")
+            L.append(f"- Scaling: closed-form body advances per body per step go from {adv(a):.3g} ({a['n']} bodies) "
+                     f"to {adv(b):.3g} ({b['n']} bodies); an impact advances only the bodies it involves and those "
+                     f"near it (lazy clocks, docs/physics.md), where moving every body to every impact's time would "
+                     f"cost impacts per step + 1.")
         L += [""]
     nd = [r["key"] for sec in out.values() if isinstance(sec, list) for r in sec if r.get("nondeterministic")]
     if nd:

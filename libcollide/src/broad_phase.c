@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "world.h"
+#include "reach_grid.h"
 
 typedef struct box { double x0, y0, x1, y1; int row; } box;
 
@@ -14,9 +15,24 @@ struct lc_broad_phase_state {
      * counting sort of the pairs */
     lc_buf sweep_order, sweep_boxes, pair_start, pair_tmp;
     int sweep_rows;
+    /* lc_broad_phase_track: where each body can be during the trial interval, in a grid, while tracked */
+    lc_reach_grid *grid;
+    int tracked;
+    lc_buf reach, track_rows, box_stamp;
+    unsigned stamp_now;
 };
 
-lc_broad_phase_state *lc_broad_phase_state_create(void) { return calloc(1, sizeof(lc_broad_phase_state)); }
+lc_broad_phase_state *lc_broad_phase_state_create(void)
+{
+    lc_broad_phase_state *bp = calloc(1, sizeof(lc_broad_phase_state));
+    if (bp == NULL) return NULL;
+    bp->grid = lc_reach_grid_create();
+    if (bp->grid == NULL) {
+        free(bp);
+        return NULL;
+    }
+    return bp;
+}
 
 void lc_broad_phase_state_destroy(lc_broad_phase_state *bp)
 {
@@ -29,6 +45,10 @@ void lc_broad_phase_state_destroy(lc_broad_phase_state *bp)
     lc_buf_free(&bp->sweep_boxes);
     lc_buf_free(&bp->pair_start);
     lc_buf_free(&bp->pair_tmp);
+    lc_buf_free(&bp->reach);
+    lc_buf_free(&bp->track_rows);
+    lc_buf_free(&bp->box_stamp);
+    lc_reach_grid_destroy(bp->grid);
     free(bp);
 }
 
@@ -234,8 +254,11 @@ static int pairs_of(lc_world *w, box *boxes, lc_buf *buf)
         if (sorted == NULL) return -1;
         w->last.sort_and_sweep_steps++;
         for (i = 0; i < n; ++i)
-            for (j = i + 1; j < n && sorted[j].x0 <= sorted[i].x1; ++j)
+            for (j = i + 1; j < n && sorted[j].x0 <= sorted[i].x1; ++j) {
+                /* most boxes in the x band lie above or below (a wide world holds ~sqrt(n) in a band) */
+                if (sorted[j].y0 > sorted[i].y1 || sorted[i].y0 > sorted[j].y1) continue;
                 if ((count = add_if_near(w, buf, count, &sorted[i], &sorted[j])) < 0) return -1;
+            }
         /* same pair order as brute force, so results do not depend on the broadphase */
         if (count > 1 && order_pairs(w, (int *)buf->p, count) != 0) return -1;
     }
@@ -275,6 +298,127 @@ int lc_broad_phase_boxes(lc_world *w, const double *boxes4, lc_buf *buf)
     return pairs_of(w, boxes, buf);
 }
 
+/* Where body i can be while it moves from s0 to s1 over h under constant accelerations: its centres'
+ * box grown by its bounding radius, the margin and the most a parabola strays from its chord
+ * (|a| h^2 / 8), with bound_box's relative allowance for round-off; a static body's own box. */
+static void reach_box(lc_world *w, const double *s0, const double *s1, double h, int i, double margin, double out[4])
+{
+    box b;
+    if (w->is_static[i]) {
+        swept_box(w, s0, s0, i, margin, &b);
+    } else {
+        double ax = w->def.gravity.x + w->ext_force[i].x * w->inv_mass[i];
+        double ay = w->def.gravity.y + w->ext_force[i].y * w->inv_mass[i];
+        bound_box(w, s0, s1, i, margin + sqrt(ax * ax + ay * ay) * h * h / 8.0, &b);
+        /* bound_box's allowance is relative to its radius: grow by the same share of the stray */
+        b.x0 -= 1e-9 * (fabs(b.x0) + 1.0);
+        b.y0 -= 1e-9 * (fabs(b.y0) + 1.0);
+        b.x1 += 1e-9 * (fabs(b.x1) + 1.0);
+        b.y1 += 1e-9 * (fabs(b.y1) + 1.0);
+    }
+    out[0] = b.x0;
+    out[1] = b.y0;
+    out[2] = b.x1;
+    out[3] = b.y1;
+}
+
+int lc_broad_phase_track(lc_world *w, const double *s0, const double *s1, double h, const int *rows, int nrows,
+                         double margin)
+{
+    lc_broad_phase_state *bp = w->broad_phase;
+    double *reach = lc_buf_get(&bp->reach, (size_t)(w->count > 0 ? w->count : 1) * 4 * sizeof(double));
+    int *all = lc_buf_get(&bp->track_rows, (size_t)(w->count > 0 ? w->count : 1) * sizeof(int));
+    int i, n = 0;
+    bp->tracked = 0;
+    if (reach == NULL || all == NULL) return -1;
+    /* the rows and every static body, in row order */
+    for (i = 0; i < w->count; ++i)
+        if (w->is_static[i]) all[n++] = i;
+    for (i = 0; i < nrows; ++i) all[n++] = rows[i];
+    for (i = 0; i < n; ++i) reach_box(w, s0, s1, h, all[i], margin, &reach[4 * all[i]]);
+    if (lc_reach_grid_build(bp->grid, reach, all, n, w->count) != 0) return -1;
+    bp->tracked = 1;
+    return 0;
+}
+
+int lc_broad_phase_retrack(lc_world *w, const double *s0, const double *s1, double h, const int *rows, int nrows,
+                           double margin)
+{
+    lc_broad_phase_state *bp = w->broad_phase;
+    int k;
+    if (!bp->tracked) return 0;
+    for (k = 0; k < nrows; ++k) {
+        double r[4];
+        reach_box(w, s0, s1, h, rows[k], margin, r);
+        if (lc_reach_grid_move(bp->grid, rows[k], r) != 0) {
+            bp->tracked = 0;
+            return -1;
+        }
+    }
+    return 0;
+}
+
+void lc_broad_phase_untrack(lc_world *w) { w->broad_phase->tracked = 0; }
+
+int lc_broad_phase_near(lc_world *w, const double box4[4], const int **out)
+{
+    if (!w->broad_phase->tracked) return -2;
+    return lc_reach_grid_query(w->broad_phase->grid, box4, out);
+}
+
+static int cmp_pair(const void *x, const void *y)
+{
+    const int *a = x, *b = y;
+    if (a[0] != b[0]) return (a[0] > b[0]) - (a[0] < b[0]);
+    return (a[1] > b[1]) - (a[1] < b[1]);
+}
+
+/* lc_broad_phase_of from the tracked reach: each listed row's partners are the bodies whose reach its
+ * box meets (a body's box over the interval lies in its reach), then the same box test; the pairs in
+ * brute force's order. */
+static int pairs_of_tracked(lc_world *w, const double *s0, const double *s1, double margin, const uint8_t *marked,
+                            const int *list, int nlist, lc_buf *buf)
+{
+    lc_broad_phase_state *bp = w->broad_phase;
+    int n = w->count, k, q, count = 0;
+    box *boxes = lc_buf_get(&bp->boxes, (size_t)(n > 0 ? n : 1) * sizeof(box));
+    unsigned *have = lc_buf_get(&bp->box_stamp, (size_t)(n > 0 ? n : 1) * sizeof(unsigned));
+    if (boxes == NULL || have == NULL) return -1;
+    if (bp->stamp_now == 0 || ++bp->stamp_now == 0) {   /* first use, or wrapped */
+        memset(have, 0, (size_t)(n > 0 ? n : 1) * sizeof(unsigned));
+        bp->stamp_now = 1;
+    }
+    for (k = 0; k < nlist; ++k) {
+        swept_box(w, s0, s1, list[k], margin, &boxes[list[k]]);
+        have[list[k]] = bp->stamp_now;
+    }
+    for (k = 0; k < nlist; ++k) {
+        const int *near;
+        double qb[4];
+        int a = list[k], m;
+        qb[0] = boxes[a].x0;
+        qb[1] = boxes[a].y0;
+        qb[2] = boxes[a].x1;
+        qb[3] = boxes[a].y1;
+        m = lc_reach_grid_query(bp->grid, qb, &near);
+        if (m < 0) return -1;
+        for (q = 0; q < m; ++q) {
+            int b = near[q];
+            if (b == a || marked[b]) continue;   /* two listed rows: below */
+            if (have[b] != bp->stamp_now) {
+                swept_box(w, s0, s1, b, margin, &boxes[b]);
+                have[b] = bp->stamp_now;
+            }
+            if ((count = add_if_near(w, buf, count, &boxes[a], &boxes[b])) < 0) return -1;
+        }
+        for (q = k + 1; q < nlist; ++q)
+            if ((count = add_if_near(w, buf, count, &boxes[a], &boxes[list[q]])) < 0) return -1;
+    }
+    if (count > 1) qsort(buf->p, (size_t)count, 2 * sizeof(int), cmp_pair);
+    w->last.broadphase_pairs += (uint64_t)count;
+    return count;
+}
+
 int lc_broad_phase_of(lc_world *w, const double *s0, const double *s1, double margin, const uint8_t *marked,
                       const int *list, int nlist, lc_buf *buf)
 {
@@ -285,6 +429,7 @@ int lc_broad_phase_of(lc_world *w, const double *s0, const double *s1, double ma
     uint8_t *have = lc_buf_get(&bp->have, (size_t)(n > 0 ? n : 1));
     int *sorted = lc_buf_get(&bp->marked, (size_t)(nlist > 0 ? nlist : 1) * sizeof(int));
     if (boxes == NULL || bounds == NULL || have == NULL || sorted == NULL) return -1;
+    if (bp->tracked) return pairs_of_tracked(w, s0, s1, margin, marked, list, nlist, buf);
     /* The listed rows' boxes now; another body's only when it could be near one of them. After an
      * impact every body has moved to the impact's time, and computing all their boxes again (a
      * cosine and sine each) was a third of a 2000-body free-flight step's time, at each impact. The

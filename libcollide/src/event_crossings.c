@@ -192,7 +192,10 @@ static int swept_check(lc_world *w, lc_event_crossings *ec, const double *s0, co
                     if (!own[0] || !own[1]) return -1;
                 }
                 dst = own[k & 1];   /* prev is the other one (or s0) */
-                if (lc_integrate(w, s0, tk, rows, nr, NULL, 0, dst) != 0) return -1;
+                /* only the pair's two rows are read (a static one as at s0) */
+                memcpy(&dst[a * 6], &s0[a * 6], 6 * sizeof(double));
+                memcpy(&dst[b * 6], &s0[b * 6], 6 * sizeof(double));
+                if (lc_integrate_rows(w, s0, tk, rows, nr, NULL, 0, dst) != 0) return -1;
                 cur = dst;
             } else {
                 /* the whole world advanced with its resting contacts, exactly as in the trial */

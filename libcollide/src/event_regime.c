@@ -29,6 +29,7 @@ struct lc_event_regime {
     lc_buf state0, state1, scratch;  /* a pass's start and trial end, and integration scratch (count x 6) */
     lc_buf rows, moved, moved_rows;  /* the advanced rows; the bodies the last impact moved */
     lc_buf marks, at_best;           /* the energy check's marks; the best time of impact's state */
+    lc_buf clock;                    /* lazy clocks: the time (from the pass's t0) each row's state is at */
 };
 
 lc_event_regime *lc_event_regime_create(void)
@@ -61,6 +62,7 @@ void lc_event_regime_destroy(lc_event_regime *er)
     lc_buf_free(&er->moved_rows);
     lc_buf_free(&er->marks);
     lc_buf_free(&er->at_best);
+    lc_buf_free(&er->clock);
     free(er);
 }
 
@@ -68,14 +70,86 @@ void lc_event_regime_rows_shifted(lc_event_regime *er) { lc_event_touches_rows_s
 
 void lc_event_regime_forget_end(lc_event_regime *er) { lc_event_touches_forget_end(er->touches); }
 
+/* 1 if every row moves in closed form (constant applied forces, no applied torque: its spin, which
+ * sets the trial interval, stays as it is; no touch: the caller's). */
+static int rows_closed_form(const lc_world *w, const int *rows, int nrows)
+{
+    int i;
+    for (i = 0; i < nrows; ++i)
+        if (!lc_body_forces_constant(w, rows[i]) || w->ext_torque[rows[i]] != 0.0) return 0;
+    return 1;
+}
+
+/* Lazy clocks (free flight while the broad phase tracks the trial): an impact advances only the bodies
+ * it involves and the ones it looks at to its time; every other body stays where its last event left
+ * it, at clock[row], until something near it looks at it or the trial ends. w->state and s0 hold each
+ * row at its clock (the impact's rows are copied from w->state to s0 at the next pass's start). */
+typedef struct lazy_clock {
+    lc_world *w;
+    double *s0, *clock;
+    double now;   /* the time the rows looked at are brought to */
+} lazy_clock;
+
+static int sync_row(void *ctx, int r)
+{
+    lazy_clock *lz = ctx;
+    lc_world *w = lz->w;
+    double h;
+    if (w->is_static[r] || lz->clock[r] == lz->now) return 0;
+    h = lz->now - lz->clock[r];
+    /* closed form in place: each row's positions are written from its velocities before those */
+    if (lc_integrate_rows(w, w->state, h, &r, 1, NULL, 0, w->state) != 0) return -1;
+    memcpy(&lz->s0[r * 6], &w->state[r * 6], 6 * sizeof(double));
+    lz->clock[r] = lz->now;
+    return 0;
+}
+
+static int sync_rows(lazy_clock *lz, const int *rows, int n)
+{
+    int i;
+    for (i = 0; i < n; ++i)
+        if (sync_row(lz, rows[i]) != 0) return -1;
+    return 0;
+}
+
+/* Brings every body the tracked broad phase finds near each of rows[0..n) (boxes between s and t,
+ * grown by margin, as lc_broad_phase_of takes them) to lz->now. */
+static int sync_near(lazy_clock *lz, const double *s, const double *t, const int *rows, int n, double margin)
+{
+    int k;
+    for (k = 0; k < n; ++k) {
+        double b[4];
+        const int *near;
+        int m;
+        lc_swept_box(lz->w, s, t, rows[k], margin, b);
+        m = lc_broad_phase_near(lz->w, b, &near);
+        if (m == -1) return -1;
+        if (m > 0 && sync_rows(lz, near, m) != 0) return -1;
+    }
+    return 0;
+}
+
+static lc_status event_advance(lc_world *w, lc_event_regime *er, const lc_step_try *step, double dt, double t0,
+                               const int *event_rows, int nrows, int *marks_known, int *handover, double *t_handover);
+
 lc_status lc_event_advance(lc_world *w, lc_event_regime *er, const lc_step_try *step, double dt, double t0,
                            const int *event_rows, int nrows, int *marks_known, int *handover, double *t_handover)
+{
+    lc_status st = event_advance(w, er, step, dt, t0, event_rows, nrows, marks_known, handover, t_handover);
+    lc_broad_phase_untrack(w);   /* the tracked reach describes this pass's trial only */
+    return st;
+}
+
+static lc_status event_advance(lc_world *w, lc_event_regime *er, const lc_step_try *step, double dt, double t0,
+                               const int *event_rows, int nrows, int *marks_known, int *handover, double *t_handover)
 {
     size_t bytes;
     double *s0, *s1, *scratch, remaining;
     int *rows, i, events = 0, nstalled = 0, nrest = 0, passes = 0, persisting = -1, last_impact_body = -1;
     int dissipative_events = 0;
-    int *drows, ndirty = 0, local_next = 0, body_springs = 0, started_deep = 0;
+    int *drows, ndirty = 0, local_next = 0, body_springs = 0, started_deep = 0, islands_alone = 0;
+    int tracked = 0, may_track = 0, lazy = 0, fresh[2] = {-1, -1};
+    lazy_clock lz;
     uint8_t *dirty;
     double last_tmin = 0.0, trial_left = 0.0, ts;
     lc_crossing stalled[LC_MAX_STALLED];
@@ -93,6 +167,11 @@ lc_status lc_event_advance(lc_world *w, lc_event_regime *er, const lc_step_try *
     drows = lc_buf_get(&er->moved_rows, (size_t)w->count * sizeof(int));
     if (!dirty || !drows) return lc_fail(w, LC_ERR_NO_MEMORY, "out of memory in step");
     memset(dirty, 0, (size_t)w->count);
+    lz.w = w;
+    lz.s0 = s0;
+    lz.clock = lc_buf_get(&er->clock, (size_t)(w->count > 0 ? w->count : 1) * sizeof(double));
+    lz.now = 0.0;
+    if (lz.clock == NULL) return lc_fail(w, LC_ERR_NO_MEMORY, "out of memory in step");
     for (i = 0; i < w->spring_count; ++i)
         if (w->springs[i].def.body_b != LC_WORLD_ANCHOR) body_springs = 1;
     /* the force callback may tie any body to any other, as a spring between bodies does */
@@ -100,7 +179,7 @@ lc_status lc_event_advance(lc_world *w, lc_event_regime *er, const lc_step_try *
 
     remaining = dt;
     while (remaining > 0.0) {
-        int nc, best = -1, nimp, hits, by_pair = 0;
+        int nc, best = -1, nimp, hits, by_pair = 0, adv[2], adv_n = 0;
         double tmin = remaining;
         lc_crossing *cross;
         lc_touch *impact;
@@ -110,6 +189,14 @@ lc_status lc_event_advance(lc_world *w, lc_event_regime *er, const lc_step_try *
         /* after an impact in free flight only the impact's bodies can have come to touch anything:
          * every other pair was apart (nothing rested) and moved without an impact */
         ts = lc_stage_begin(w);
+        lz.now = dt - remaining;
+        if (lazy) {
+            /* the impact's rows to s0, and what the resting search below looks at to now */
+            for (i = 0; i < ndirty; ++i) memcpy(&s0[drows[i] * 6], &w->state[drows[i] * 6], 6 * sizeof(double));
+            for (i = 0; i < 2; ++i)
+                if (fresh[i] >= 0) memcpy(&s0[fresh[i] * 6], &w->state[fresh[i] * 6], 6 * sizeof(double));
+            if (sync_near(&lz, w->state, w->state, drows, ndirty, w->def.contact_distance) != 0) goto oom;
+        }
         if (local_next && !body_springs)
             nrest = lc_event_resting(w, er->touches, w->state, &events, dirty, drows, ndirty, passes > 0, &started_deep,
                                      &persisting, &rest);
@@ -124,6 +211,12 @@ lc_status lc_event_advance(lc_world *w, lc_event_regime *er, const lc_step_try *
         /* from here on that touch persists, which the contact regime advances (regime.h); so does a burst
          * of impacts (inelastic collapse: a block bouncing ever lower, e^k, where no speed threshold
          * stops it) */
+        if (lazy && (nrest != 0 || events != events_before || !local_next ||
+                     (handover != NULL && (persisting >= 0 || dissipative_events >= LC_HANDOVER_EVENTS)))) {
+            /* not a local pass: every body to now, as the global clock has them */
+            if (sync_rows(&lz, rows, nrows) != 0) goto oom;
+            lazy = 0;
+        }
         if (handover != NULL && persisting < 0 && dissipative_events >= LC_HANDOVER_EVENTS) persisting = last_impact_body;
         if (handover != NULL && persisting >= 0) {
             lc_island isl = lc_islands_get(w->islands, lc_islands_of(w->islands, persisting));
@@ -133,7 +226,7 @@ lc_status lc_event_advance(lc_world *w, lc_event_regime *er, const lc_step_try *
                 return LC_OK;
             }
         }
-        memcpy(s0, w->state, (size_t)w->count * 6 * sizeof(double));
+        if (!lazy) memcpy(s0, w->state, (size_t)w->count * 6 * sizeof(double));
         /* Vertex paths are tested as straight lines in the other body's frame; that holds while bodies
          * turn little, so a fast spinner is checked over shorter trial intervals. */
         for (i = 0; i < nrows; ++i) wmax = fmax(wmax, fabs(s0[rows[i] * 6 + SW]));
@@ -143,6 +236,11 @@ lc_status lc_event_advance(lc_world *w, lc_event_regime *er, const lc_step_try *
         if (trial < dt / LC_MAX_TRIALS) trial = fmin(remaining, dt / LC_MAX_TRIALS);
         /* the rest of the previous trial, if the turning limit allows it: then its end is the same */
         can_reuse = local_next && trial_left > 0.0 && trial_left <= trial;
+        if (lazy && !can_reuse) {
+            /* a new trial interval: every body to now (s0 of the lagging rows was theirs) */
+            if (sync_rows(&lz, rows, nrows) != 0) goto oom;
+            lazy = 0;
+        }
         if (can_reuse) trial = trial_left;
         if (++passes > w->def.max_events_per_step + 2 * LC_MAX_TRIALS)
             return lc_step_undo(w, step, LC_ERR_NUMERIC,
@@ -171,13 +269,36 @@ lc_status lc_event_advance(lc_world *w, lc_event_regime *er, const lc_step_try *
             if (lc_integrate(w, s0, trial, rows, nrows, rest, nrest, s1) != 0) goto oom;
         }
         lc_stage_end(w, &w->last.time_integration, ts);
-        for (i = 0; i < nrows; ++i) {
-            int k;
+        /* a local pass wrote only the impact's rows (the others were checked when written) */
+        for (i = 0; i < (local ? ndirty : nrows); ++i) {
+            int k, r = local ? drows[i] : rows[i];
             for (k = 0; k < 6; ++k)
-                if (!isfinite(s1[rows[i] * 6 + k]))
+                if (!isfinite(s1[r * 6 + k]))
                     return lc_step_undo(w, step, LC_ERR_NUMERIC,
                                         "integration produced a non-finite state (forces too stiff for dt?)");
         }
+        /* A trial interval's first impact is followed by local passes (above): from the first of them on,
+         * where every body can be until the interval ends is tracked in a grid, and each impact's bodies
+         * only are moved in it; their pairs and impact groups are then found among what is near them,
+         * not among every body. Free flight only: a body in closed form stays on its path. */
+        if (!local) {
+            lc_broad_phase_untrack(w);
+            tracked = 0;
+            may_track = nrest == 0 && !body_springs && nrows >= LC_TRACK_MIN_ROWS;
+        } else if (tracked) {
+            if (lc_broad_phase_retrack(w, s0, s1, trial, drows, ndirty, w->def.contact_distance) != 0) goto oom;
+        } else if (may_track) {
+            may_track = 0;
+            if (rows_closed_form(w, rows, nrows)) {
+                if (lc_broad_phase_track(w, s0, s1, trial, rows, nrows, w->def.contact_distance) != 0) goto oom;
+                tracked = 1;
+                /* every row is at now: from here on each keeps its own clock */
+                lazy = 1;
+                for (i = 0; i < nrows; ++i) lz.clock[rows[i]] = lz.now;
+            }
+        }
+        /* what this pass's pairs look at (the bodies near the impact's), to now */
+        if (lazy && sync_near(&lz, s0, s1, drows, ndirty, w->def.contact_distance) != 0) goto oom;
         if (nrest > 0) {
             uint8_t *mark = lc_buf_get(&er->marks, (size_t)w->count);
             if (mark == NULL) goto oom;
@@ -208,13 +329,20 @@ lc_status lc_event_advance(lc_world *w, lc_event_regime *er, const lc_step_try *
             nc = lc_event_crossings_find(w, er->crossings, &tr, local ? &moved : NULL, stalled, nstalled, &cross);
             lc_stage_end(w, &w->last.time_detection, ts);
             if (nc < 0) goto oom;
+            /* the kept crossings' bodies to now, for their time-of-impact searches from s0 */
+            for (i = 0; i < nc && lazy; ++i)
+                if (sync_row(&lz, cross[i].a) != 0 || sync_row(&lz, cross[i].b) != 0) goto oom;
         }
         /* earliest time of impact; a crossing whose gap is still open at the best time so far is later.
          * Each evaluation advances only the islands of the crossing's two bodies; those islands at
          * the best time so far are kept for the next crossing of the same islands (a pile is one
          * island, and each of its integrations solves the whole pile's contact forces). */
         ts = lc_stage_begin(w);
-        if (nc > 0 && lc_touch_islands_build(w, er->islands, rows, nrows, rest, nrest) != 0) goto oom;
+        /* a local pass has no resting touch and no spring between bodies: the islands of the last build
+         * without touches are still every row on its own */
+        if (nc > 0 && !(local && islands_alone) && lc_touch_islands_build(w, er->islands, rows, nrows, rest, nrest) != 0)
+            goto oom;
+        if (nc > 0) islands_alone = nrest == 0 && !body_springs;
         {
             double *at_best = NULL, at_t = -1.0;
             int at_ia = -2, at_ib = -2;
@@ -229,11 +357,15 @@ lc_status lc_event_advance(lc_world *w, lc_event_regime *er, const lc_step_try *
                     int ia = lc_touch_island(er->islands, cross[i].a), ib = lc_touch_island(er->islands, cross[i].b);
                     if (at_best == NULL && (at_best = lc_buf_get(&er->at_best, bytes)) == NULL) goto oom;
                     if (at_t != tmin || at_ia != ia || at_ib != ib) {
-                        if (lc_integrate(w, s0, tmin, erows, nerows, erest, nerest, at_best) != 0) goto oom;
+                        /* the two islands' rows only: every crossing read here has its bodies in them,
+                         * or static (copied below) */
+                        if (lc_integrate_rows(w, s0, tmin, erows, nerows, erest, nerest, at_best) != 0) goto oom;
                         at_t = tmin;
                         at_ia = ia;
                         at_ib = ib;
                     }
+                    if (w->is_static[cross[i].a]) memcpy(&at_best[cross[i].a * 6], &s0[cross[i].a * 6], 6 * sizeof(double));
+                    if (w->is_static[cross[i].b]) memcpy(&at_best[cross[i].b * 6], &s0[cross[i].b * 6], 6 * sizeof(double));
                     g = lc_vertex_edge_gap(w, at_best, cross[i].a, cross[i].vertex, cross[i].b, cross[i].edge);
                     if (g > w->def.contact_gap) continue;
                 }
@@ -246,6 +378,7 @@ lc_status lc_event_advance(lc_world *w, lc_event_regime *er, const lc_step_try *
         lc_stage_end(w, &w->last.time_toi_search, ts);
         if (best < 0) {
             local_next = 0;
+            lazy = 0;   /* every row to the trial's end */
             memcpy(w->state, s1, (size_t)w->count * 6 * sizeof(double));
             remaining -= trial;
             if (remaining < 1e-14 * dt) remaining = 0.0;
@@ -254,9 +387,17 @@ lc_status lc_event_advance(lc_world *w, lc_event_regime *er, const lc_step_try *
         }
 
         ts = lc_stage_begin(w);
+        /* lazy clocks: only the crossing's two bodies go to the impact's time here (the others it acts
+         * on are brought there as the impact group finds them) */
+        adv_n = 0;
+        if (lazy) {
+            if (!w->is_static[cross[best].a]) adv[adv_n++] = cross[best].a;
+            if (!w->is_static[cross[best].b]) adv[adv_n++] = cross[best].b;
+        }
         if (tmin > 0.0) {
             int ba = cross[best].a, bb = cross[best].b;
-            if (lc_integrate_rows(w, s0, tmin, rows, nrows, rest, nrest, w->state) != 0) goto oom;
+            if (lc_integrate_rows(w, s0, tmin, lazy ? adv : rows, lazy ? adv_n : nrows, rest, nrest, w->state) != 0)
+                goto oom;
             /* another vertex of the pair (corner against corner) already inside, deeper than any
              * crossing test can see from here on: the pair met earlier, find when */
             if (lc_pair_separation(w, w->state, ba, bb) < -0.5 * w->def.contact_gap &&
@@ -274,9 +415,10 @@ lc_status lc_event_advance(lc_world *w, lc_event_regime *er, const lc_step_try *
                 if (t2 < 0.0) goto oom;
                 tmin = t2;
                 by_pair = 1;
-                if (lc_integrate_rows(w, s0, tmin, rows, nrows, rest, nrest, w->state) != 0) goto oom;
+                if (lc_integrate_rows(w, s0, tmin, lazy ? adv : rows, lazy ? adv_n : nrows, rest, nrest, w->state) != 0)
+                    goto oom;
             }
-        } else {
+        } else if (!lazy) {
             memcpy(w->state, s0, (size_t)w->count * 6 * sizeof(double));
         }
         lc_stage_end(w, &w->last.time_integration, ts);
@@ -284,8 +426,12 @@ lc_status lc_event_advance(lc_world *w, lc_event_regime *er, const lc_step_try *
         w->time = t0 + (dt - remaining);
         if (remaining < 1e-14 * dt) remaining = 0.0;
 
+        lz.now = dt - remaining;
+        for (i = 0; i < adv_n; ++i) lz.clock[adv[i]] = lz.now;
+        fresh[0] = adv_n > 0 ? adv[0] : -1;
+        fresh[1] = adv_n > 1 ? adv[1] : -1;
         ts = lc_stage_begin(w);
-        nimp = lc_event_impact_group(w, er->touches, w->state, &cross[best], by_pair, &impact);
+        nimp = lc_event_impact_group(w, er->touches, w->state, &cross[best], by_pair, &impact, lazy ? sync_row : NULL, &lz);
         if (nimp < 0) goto oom;
         /* past max_events_per_step (an impact storm: extreme speeds in a small box, a jam at e > 0)
          * every further impact is inelastic, which ends the storm; the pass cap above still bounds it */
@@ -328,6 +474,11 @@ lc_status lc_event_advance(lc_world *w, lc_event_regime *er, const lc_step_try *
             if (nstalled < LC_MAX_STALLED) stalled[nstalled] = cross[best];
             nstalled++;
         }
+    }
+    if (lazy) {
+        /* every body to the end of the step */
+        lz.now = dt - remaining;
+        if (sync_rows(&lz, rows, nrows) != 0) goto oom;
     }
     if (remaining == 0.0) w->time = t0 + dt;
     if (handover != NULL) *handover = -1;

@@ -255,7 +255,7 @@ int lc_event_keep_warm(lc_event_touches *et, const lc_touch *t, int n)
  * When the time came from the pair's separation (by_pair), the crossing's vertex need not be the one
  * touching: the pair's touches are its separating-axis manifold alone. */
 int lc_event_impact_group(lc_world *w, lc_event_touches *et, const double *state, const lc_crossing *c, int by_pair,
-                          lc_touch **out)
+                          lc_touch **out, int (*sync)(void *ctx, int row), void *ctx)
 {
     int *queue = lc_buf_get(&et->group, (size_t)w->count * (sizeof(int) + 1));
     uint8_t *seen;   /* 1 queued, 2 done */
@@ -267,11 +267,28 @@ int lc_event_impact_group(lc_world *w, lc_event_touches *et, const double *state
     if (!w->is_static[c->a]) { seen[c->a] = 1; queue[nq++] = c->a; }
     if (!w->is_static[c->b]) { seen[c->b] = 1; queue[nq++] = c->b; }
     for (q = 0; q < nq; ++q) {
-        int body = queue[q];
-        for (k = 0; k < w->count; ++k) {
+        int body = queue[q], m, j;
+        const int *near = NULL;
+        /* while the broad phase tracks the trial (free flight), only the bodies whose reach meets this
+         * one's circle grown by contact_distance can pass the distance test below: the same bodies in
+         * the same order, without visiting every body */
+        {
+            double qb[4], rq = w->shape[body].radius + w->def.contact_distance;
+            qb[0] = state[body * 6 + SX] - rq;
+            qb[1] = state[body * 6 + SY] - rq;
+            qb[2] = state[body * 6 + SX] + rq;
+            qb[3] = state[body * 6 + SY] + rq;
+            m = lc_broad_phase_near(w, qb, &near);
+            if (m == -1) return -1;
+            if (m < 0) m = w->count;
+        }
+        for (j = 0; j < m; ++j) {
             double dx, dy, r;
             int before = n;
+            k = near != NULL ? near[j] : j;
             if (k == body || seen[k] == 2) continue;   /* a pair with a finished body was collected */
+            /* a body whose clock lags (event_regime.c) is brought to the impact's time first */
+            if (near != NULL && sync != NULL && sync(ctx, k) != 0) return -1;
             if (w->excluded && w->excluded[k]) continue;   /* another island's */
             dx = state[body * 6 + SX] - state[k * 6 + SX];
             dy = state[body * 6 + SY] - state[k * 6 + SY];

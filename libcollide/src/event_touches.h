@@ -28,9 +28,12 @@ int lc_event_resting(lc_world *w, lc_event_touches *et, double *state, int *impa
 /* Keeps a pass's resting touches and their forces for the next pass's warm start. 0, or -1. */
 int lc_event_keep_warm(lc_event_touches *et, const lc_touch *t, int n);
 /* The touches an impact at crossing c acts on (into *out, valid until the next call): every touch of the
- * group of bodies joined by touches to c's two, or (by_pair) that pair's own. Returns the count, or -1. */
+ * group of bodies joined by touches to c's two, or (by_pair) that pair's own. While the broad phase
+ * tracks the trial, sync (when not NULL) is called on each body near the group before it is looked at
+ * (it brings that row of `state` to the impact's time; 0, or -1 without memory). Returns the count, or
+ * -1. */
 int lc_event_impact_group(lc_world *w, lc_event_touches *et, const double *state, const lc_crossing *c, int by_pair,
-                          lc_touch **out);
+                          lc_touch **out, int (*sync)(void *ctx, int row), void *ctx);
 
 /* The touches `found` (n of them) were searched at w->state, where the step ends: they are kept (buffers
  * swapped) for the next step's first whole-world search. 0, or -1 without memory. */

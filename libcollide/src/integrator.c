@@ -143,12 +143,16 @@ static int integrate(lc_world *w, const double *s0, double h, const int *rows, i
         for (i = 0; i < nrows; ++i)
             if (h == 0.0 || w->is_static[rows[i]]) memcpy(&s1[rows[i] * 6], &s0[rows[i] * 6], 6 * sizeof(double));
     if (h == 0.0) return 0;   /* no time passes: no force evaluation (a pile's is a full contact solve) */
-    memset(flags, 0, (size_t)w->count * sizeof(int));
-    for (i = 0; i < nt; ++i) flags[touches[i].a] = flags[touches[i].b] = 1;
+    /* without touches no row is flagged: a time-of-impact search of two bodies in a large world must
+     * not clear a flag per body at each of its iterations */
+    if (nt > 0) {
+        memset(flags, 0, (size_t)w->count * sizeof(int));
+        for (i = 0; i < nt; ++i) flags[touches[i].a] = flags[touches[i].b] = 1;
+    }
     for (i = 0; i < nrows; ++i) {
         int r = rows[i];
         if (w->is_static[r]) continue;
-        if (!flags[r] && lc_body_forces_constant(w, r)) {
+        if ((nt == 0 || !flags[r]) && lc_body_forces_constant(w, r)) {
             advance_closed_form(w, s0, h, r, s1);
             w->last.analytic_advances++;
         } else {

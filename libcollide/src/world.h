@@ -288,6 +288,19 @@ int lc_broad_phase_boxes(lc_world *w, const double *boxes4, lc_buf *buf);
 /* The same, restricted to pairs with at least one of the nlist bodies in list (marked[row] != 0). */
 int lc_broad_phase_of(lc_world *w, const double *s0, const double *s1, double margin, const uint8_t *marked,
                       const int *list, int nlist, lc_buf *buf);
+/* The event regime's trial interval in a grid (reach_grid.h): where each of rows[0..nrows) (advanced from
+ * s0 over h to s1 under constant accelerations, no touch) and each static body can be until the
+ * interval ends. While tracked, lc_broad_phase_of and lc_broad_phase_near visit only what is near, for
+ * states between s0 and s1. 0, or -1 without memory (then untracked). */
+int lc_broad_phase_track(lc_world *w, const double *s0, const double *s1, double h, const int *rows, int nrows,
+                         double margin);
+/* Rows rows[0..nrows) now go from s0 over h to s1 (an impact changed their paths). 0, or -1 (untracked). */
+int lc_broad_phase_retrack(lc_world *w, const double *s0, const double *s1, double h, const int *rows, int nrows,
+                           double margin);
+void lc_broad_phase_untrack(lc_world *w);
+/* The tracked rows whose reach meets box4 (x0, y0, x1, y1), in ascending row order, into *out: their
+ * count, -1 without memory, or -2 when nothing is tracked. */
+int lc_broad_phase_near(lc_world *w, const double box4[4], const int **out);
 
 /* ---- response.c ---- */
 /* Change of relative velocity along di at touch ti per unit impulse along dj at touch tj (J M^-1 J^T). */

@@ -9,7 +9,9 @@
  * one column (every box overlaps every other in x) - and after each the pair list of sort-and-sweep
  * must equal brute force's entry for entry, with no tolerance: both test the same boxes. So must the
  * pairs of lc_broad_phase_of (the pairs of a few listed bodies, after an impact) equal brute force's
- * pairs that have a listed body. */
+ * pairs that have a listed body, also while the broad phase tracks an interval in its grid
+ * (lc_broad_phase_track): at a state inside the interval, and after a hundred bodies changed paths
+ * (lc_broad_phase_retrack, past the share of moved bodies at which the grid is built anew). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -120,6 +122,30 @@ int main(void)
     for (i = 1; i < rows; i++) s1[i * 6 + SX] += sc_uniform(&rng, -2.0, 2.0);
     compare(w, s0, s1, "swept over an interval", brute, sweep);
     compare_of(w, s0, s1, "swept over an interval", brute, sweep, &rng);
+    {
+        /* tracked: every dynamic body's reach from s0 to s1 (straight paths: h = 0, no parabola) */
+        int *dyn = malloc((size_t)rows * sizeof(int)), nd = 0, k;
+        double *sm = malloc((size_t)rows * 6 * sizeof(double)), *s2 = malloc((size_t)rows * 6 * sizeof(double));
+        const int *near;
+        CHECK(dyn && sm && s2, "%s", "allocation");
+        if (dyn && sm && s2) {
+            for (k = 1; k < rows; k++) dyn[nd++] = k;
+            CHECK(lc_broad_phase_track(w, s0, s1, 0.0, dyn, nd, w->def.contact_distance) == 0, "%s", "track");
+            compare_of(w, s0, s1, "tracked", brute, sweep, &rng);
+            memcpy(sm, s0, (size_t)rows * 6 * sizeof(double));
+            for (k = 1; k < rows; k++) sm[k * 6 + SX] = 0.5 * (s0[k * 6 + SX] + s1[k * 6 + SX]);
+            compare_of(w, sm, s1, "tracked, mid-interval", brute, sweep, &rng);
+            memcpy(s2, s1, (size_t)rows * 6 * sizeof(double));
+            for (k = 1; k <= 100; k++) s2[k * 6 + SY] += sc_uniform(&rng, -3.0, 3.0);
+            CHECK(lc_broad_phase_retrack(w, sm, s2, 0.0, dyn, 100, w->def.contact_distance) == 0, "%s", "retrack");
+            compare_of(w, sm, s2, "tracked, 100 paths changed", brute, sweep, &rng);
+            lc_broad_phase_untrack(w);
+            CHECK(lc_broad_phase_near(w, &s0[0], &near) == -2, "%s", "nothing is tracked after untrack");
+        }
+        free(dyn);
+        free(sm);
+        free(s2);
+    }
     for (i = 1; i < rows; i++) {
         s0[i * 6 + SX] = sc_uniform(&rng, -0.1, 0.1);
         s0[i * 6 + SY] = 0.8 * i;

@@ -1,0 +1,219 @@
+/* The reach grid (reach_grid.h): cells of one size in a compressed table (each cell's rows together,
+ * built by a counting sort); a box wider than a few cells sits in a list that every query scans (walls
+ * and floors). A moved row leaves its old entries in the table, marked stale, and is scanned from a
+ * list of moved rows until that list grows past a share of the rows, when the table is built anew: a
+ * move costs O(1) and a query what lies in its cells plus the moved rows. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include "reach_grid.h"
+
+#define LC_GRID_MAX_SPAN 4   /* a box over more cells than this along an axis goes to the wide list */
+
+struct lc_reach_grid {
+    int count;                       /* rows of the world */
+    double x0, y0, cell;             /* the grid's origin and cell size */
+    int nx, ny;
+    lc_buf box;                      /* count x 4: each indexed row's box */
+    lc_buf state;                    /* count: 0 not indexed, 1 in the table, 2 wide, 3 moved */
+    lc_buf cell_start, cell_rows;    /* the table: rows of cell c at cell_rows[cell_start[c] .. cell_start[c + 1]) */
+    lc_buf wide, moved;              /* rows in the wide list and moved rows (counts below) */
+    int nwide, nmoved, nindexed;
+    lc_buf stamp, found;             /* a query's dedup stamps (count) and its result */
+    unsigned stamp_now;
+    lc_buf rows_tmp;                 /* the rebuild's row list */
+};
+
+lc_reach_grid *lc_reach_grid_create(void) { return calloc(1, sizeof(lc_reach_grid)); }
+
+void lc_reach_grid_destroy(lc_reach_grid *g)
+{
+    if (g == NULL) return;
+    lc_buf_free(&g->box);
+    lc_buf_free(&g->state);
+    lc_buf_free(&g->cell_start);
+    lc_buf_free(&g->cell_rows);
+    lc_buf_free(&g->wide);
+    lc_buf_free(&g->moved);
+    lc_buf_free(&g->stamp);
+    lc_buf_free(&g->found);
+    lc_buf_free(&g->rows_tmp);
+    free(g);
+}
+
+/* The cell range [i0, i1] x [j0, j1] a box covers, clamped to the grid. */
+static void cell_range(const lc_reach_grid *g, const double *b, int *i0, int *j0, int *i1, int *j1)
+{
+    double fx0 = floor((b[0] - g->x0) / g->cell), fy0 = floor((b[1] - g->y0) / g->cell);
+    double fx1 = floor((b[2] - g->x0) / g->cell), fy1 = floor((b[3] - g->y0) / g->cell);
+    *i0 = fx0 < 0.0 ? 0 : (fx0 > g->nx - 1 ? g->nx - 1 : (int)fx0);
+    *j0 = fy0 < 0.0 ? 0 : (fy0 > g->ny - 1 ? g->ny - 1 : (int)fy0);
+    *i1 = fx1 < 0.0 ? 0 : (fx1 > g->nx - 1 ? g->nx - 1 : (int)fx1);
+    *j1 = fy1 < 0.0 ? 0 : (fy1 > g->ny - 1 ? g->ny - 1 : (int)fy1);
+}
+
+static int is_wide(const lc_reach_grid *g, const double *b)
+{
+    return b[2] - b[0] > LC_GRID_MAX_SPAN * g->cell || b[3] - b[1] > LC_GRID_MAX_SPAN * g->cell;
+}
+
+int lc_reach_grid_build(lc_reach_grid *g, const double *boxes4, const int *rows, int n, int count)
+{
+    double *box = lc_buf_get(&g->box, (size_t)(count > 0 ? count : 1) * 4 * sizeof(double));
+    uint8_t *state = lc_buf_get(&g->state, (size_t)(count > 0 ? count : 1));
+    int *wide = lc_buf_get(&g->wide, (size_t)(n > 0 ? n : 1) * sizeof(int));
+    int *moved = lc_buf_get(&g->moved, (size_t)(n > 0 ? n : 1) * sizeof(int));
+    unsigned *stamp = lc_buf_get(&g->stamp, (size_t)(count > 0 ? count : 1) * sizeof(unsigned));
+    double ext = 0.0, xmin = INFINITY, ymin = INFINITY, xmax = -INFINITY, ymax = -INFINITY;
+    int *start, *cells, i, k, ncell, small = 0;
+    if (!box || !state || !wide || !moved || !stamp) return -1;
+    if (g->count != count) {
+        memset(stamp, 0, (size_t)(count > 0 ? count : 1) * sizeof(unsigned));
+        g->stamp_now = 0;
+    }
+    g->count = count;
+    memset(state, 0, (size_t)(count > 0 ? count : 1));
+    /* the cell: the mean extent of the boxes, so a typical box covers one to four cells */
+    for (k = 0; k < n; ++k) {
+        const double *b = &boxes4[4 * rows[k]];
+        if (b != &box[4 * rows[k]]) memcpy(&box[4 * rows[k]], b, 4 * sizeof(double));
+        ext += fmax(b[2] - b[0], b[3] - b[1]);
+    }
+    g->cell = n > 0 && ext > 0.0 ? ext / n : 1.0;
+    for (k = 0; k < n; ++k) {
+        const double *b = &box[4 * rows[k]];
+        if (is_wide(g, b)) continue;
+        xmin = fmin(xmin, b[0]);
+        ymin = fmin(ymin, b[1]);
+        xmax = fmax(xmax, b[2]);
+        ymax = fmax(ymax, b[3]);
+        small++;
+    }
+    if (small == 0) xmin = ymin = xmax = ymax = 0.0;
+    g->x0 = xmin;
+    g->y0 = ymin;
+    /* at most about four cells per row: bodies strewn far apart make the cells larger, not the table */
+    for (;;) {
+        double nxd = floor((xmax - xmin) / g->cell) + 1.0, nyd = floor((ymax - ymin) / g->cell) + 1.0;
+        if (nxd * nyd <= 4.0 * n + 16.0) {
+            g->nx = (int)nxd;
+            g->ny = (int)nyd;
+            break;
+        }
+        g->cell *= 2.0;
+    }
+    ncell = g->nx * g->ny;
+    start = lc_buf_get(&g->cell_start, (size_t)(ncell + 1) * sizeof(int));
+    if (start == NULL) return -1;
+    memset(start, 0, (size_t)(ncell + 1) * sizeof(int));
+    g->nwide = g->nmoved = 0;
+    for (k = 0; k < n; ++k) {
+        int r = rows[k], i0, j0, i1, j1, ii, jj;
+        if (is_wide(g, &box[4 * r])) {
+            state[r] = 2;
+            wide[g->nwide++] = r;
+            continue;
+        }
+        state[r] = 1;
+        cell_range(g, &box[4 * r], &i0, &j0, &i1, &j1);
+        for (jj = j0; jj <= j1; ++jj)
+            for (ii = i0; ii <= i1; ++ii) start[jj * g->nx + ii + 1]++;
+    }
+    for (i = 0; i < ncell; ++i) start[i + 1] += start[i];
+    cells = lc_buf_get(&g->cell_rows, (size_t)(start[ncell] > 0 ? start[ncell] : 1) * sizeof(int));
+    if (cells == NULL) return -1;
+    /* rows in ascending order within each cell (the pass goes through rows in their given order, and
+     * start[] counts forward: start[c] becomes the cell's end) */
+    for (k = 0; k < n; ++k) {
+        int r = rows[k], i0, j0, i1, j1, ii, jj;
+        if (state[r] != 1) continue;
+        cell_range(g, &box[4 * r], &i0, &j0, &i1, &j1);
+        for (jj = j0; jj <= j1; ++jj)
+            for (ii = i0; ii <= i1; ++ii) cells[start[jj * g->nx + ii]++] = r;
+    }
+    for (i = ncell; i > 0; --i) start[i] = start[i - 1];
+    start[0] = 0;
+    g->nindexed = n;
+    return 0;
+}
+
+int lc_reach_grid_move(lc_reach_grid *g, int row, const double b[4])
+{
+    double *box = (double *)g->box.p;
+    uint8_t *state = (uint8_t *)g->state.p;
+    memcpy(&box[4 * row], b, 4 * sizeof(double));
+    if (state[row] == 3 || state[row] == 2) return 0;   /* scanned from its list already */
+    if (state[row] == 0) g->nindexed++;
+    state[row] = 3;
+    {
+        int *moved = lc_buf_get(&g->moved, (size_t)(g->nmoved + 1) * sizeof(int));
+        if (moved == NULL) return -1;
+        moved[g->nmoved++] = row;
+    }
+    /* past a share of the rows, scanning the moved list costs more than a new table */
+    if (g->nmoved > 32 + g->nindexed / 16) {
+        int *rows = lc_buf_get(&g->rows_tmp, (size_t)g->count * sizeof(int));
+        int i, n = 0;
+        if (rows == NULL) return -1;
+        for (i = 0; i < g->count; ++i)
+            if (state[i]) rows[n++] = i;
+        return lc_reach_grid_build(g, box, rows, n, g->count);
+    }
+    return 0;
+}
+
+static int overlaps(const double *a, const double *b)
+{
+    return a[0] <= b[2] && b[0] <= a[2] && a[1] <= b[3] && b[1] <= a[3];
+}
+
+static int cmp_int(const void *x, const void *y)
+{
+    int a = *(const int *)x, b = *(const int *)y;
+    return (a > b) - (a < b);
+}
+
+int lc_reach_grid_query(lc_reach_grid *g, const double q[4], const int **out)
+{
+    const double *box = (const double *)g->box.p;
+    const uint8_t *state = (const uint8_t *)g->state.p;
+    const int *start = (const int *)g->cell_start.p, *cells = (const int *)g->cell_rows.p;
+    unsigned *stamp = (unsigned *)g->stamp.p;
+    int *found, n = 0, i0, j0, i1, j1, ii, jj, k, cap = 64;
+    if (++g->stamp_now == 0) {   /* wrapped: every stamp is stale again */
+        memset(stamp, 0, (size_t)g->count * sizeof(unsigned));
+        g->stamp_now = 1;
+    }
+    found = lc_buf_get(&g->found, (size_t)cap * sizeof(int));
+    if (found == NULL) return -1;
+#define LC_GRID_TAKE(r)                                                                  \
+    do {                                                                                 \
+        int r_ = (r);                                                                    \
+        if (stamp[r_] == g->stamp_now || !overlaps(&box[4 * r_], q)) break;              \
+        stamp[r_] = g->stamp_now;                                                        \
+        if (n == cap) {                                                                  \
+            cap *= 2;                                                                    \
+            if ((found = lc_buf_get(&g->found, (size_t)cap * sizeof(int))) == NULL) return -1; \
+        }                                                                                \
+        found[n++] = r_;                                                                 \
+    } while (0)
+    if (!(q[0] <= q[2] && q[1] <= q[3])) {
+        *out = found;
+        return 0;
+    }
+    /* boxes beyond the table's extent sit in its edge cells, and a query that meets one is clamped to
+     * them too (the clamp keeps the order of interval ends) */
+    cell_range(g, q, &i0, &j0, &i1, &j1);
+    for (jj = j0; jj <= j1; ++jj)
+        for (ii = i0; ii <= i1; ++ii) {
+            int c = jj * g->nx + ii;
+            for (k = start[c]; k < start[c + 1]; ++k)
+                if (state[cells[k]] == 1) LC_GRID_TAKE(cells[k]);
+        }
+    for (k = 0; k < g->nwide; ++k) LC_GRID_TAKE(((const int *)g->wide.p)[k]);
+    for (k = 0; k < g->nmoved; ++k) LC_GRID_TAKE(((const int *)g->moved.p)[k]);
+#undef LC_GRID_TAKE
+    if (n > 1) qsort(found, (size_t)n, sizeof(int), cmp_int);
+    *out = found;
+    return n;
+}
