@@ -62,12 +62,21 @@ static lc_status check_output(lc_world *w, const void *out, int capacity, const 
     return LC_OK;
 }
 
+/* A ray's ends (named start_name, end_name in messages) finite and within range, and apart; what: how a
+ * message names the ray. */
+static lc_status check_segment(lc_world *w, lc_vec2 start, lc_vec2 end, const char *start_name, const char *end_name,
+                               const char *what)
+{
+    LC_TRY(lc_check_vec(w, start, 1e9, start_name));
+    LC_TRY(lc_check_vec(w, end, 1e9, end_name));
+    if (start.x == end.x && start.y == end.y)
+        return lc_fail(w, LC_ERR_OUT_OF_RANGE, "%s has zero length (start = end = (%g, %g))", what, start.x, start.y);
+    return LC_OK;
+}
+
 static lc_status check_ray(lc_world *w, lc_vec2 start, lc_vec2 end, const lc_query_filter *f)
 {
-    LC_TRY(lc_check_vec(w, start, 1e9, "start"));
-    LC_TRY(lc_check_vec(w, end, 1e9, "end"));
-    if (start.x == end.x && start.y == end.y)
-        return lc_fail(w, LC_ERR_OUT_OF_RANGE, "the ray has zero length (start = end = (%g, %g))", start.x, start.y);
+    LC_TRY(check_segment(w, start, end, "start", "end", "the ray"));
     return check_filter(w, f);
 }
 
@@ -193,26 +202,39 @@ static int cmp_hit(const void *x, const void *y)
 /* Calls fn with the hit of each body the segment from start to end meets, in row order. */
 typedef void (*hit_fn)(const lc_ray_hit *hit, void *ctx);
 
+/* The box (x0, y0, x1, y1) around the segment from a to b. */
+static void segment_box(lc_vec2 a, lc_vec2 b, double box[4])
+{
+    box[0] = fmin(a.x, b.x);
+    box[1] = fmin(a.y, b.y);
+    box[2] = fmax(a.x, b.x);
+    box[3] = fmax(a.y, b.y);
+}
+
+/* The ray from start along d against the body of row (its box: bounds; the ray's: span); fn on a hit. */
+static void cast_row(const lc_world *w, int row, const double bounds[4], const double span[4], lc_vec2 start,
+                     lc_vec2 d, hit_fn fn, void *ctx)
+{
+    polygon p;
+    lc_ray_hit hit;
+    if (!boxes_overlap(bounds, span)) return;
+    world_polygon(w, row, &p);
+    if (!ray_polygon(&p, start, d, &hit)) return;
+    hit.body = w->ids[row];
+    fn(&hit, ctx);
+}
+
 static void cast(const lc_world *w, lc_vec2 start, lc_vec2 end, const lc_query_filter *f, hit_fn fn, void *ctx)
 {
     lc_vec2 d = lc_sub(end, start);
     double span[4];
     int row;
-    span[0] = fmin(start.x, end.x);
-    span[1] = fmin(start.y, end.y);
-    span[2] = fmax(start.x, end.x);
-    span[3] = fmax(start.y, end.y);
+    segment_box(start, end, span);
     for (row = 0; row < w->count; ++row) {
         double bounds[4];
-        polygon p;
-        lc_ray_hit hit;
         if (skipped(w, f, row)) continue;
         body_bounds(w, row, bounds);
-        if (!boxes_overlap(bounds, span)) continue;
-        world_polygon(w, row, &p);
-        if (!ray_polygon(&p, start, d, &hit)) continue;
-        hit.body = w->ids[row];
-        fn(&hit, ctx);
+        cast_row(w, row, bounds, span, start, d, fn, ctx);
     }
 }
 
@@ -295,15 +317,11 @@ lc_status lc_world_ray_cast_all(const lc_world *world, lc_vec2 start, lc_vec2 en
 /* Ray i of a batch checked as lc_world_ray_cast checks its ray, the message naming the index. */
 static lc_status check_batch_ray(lc_world *w, const lc_vec2 *starts, const lc_vec2 *ends, int i)
 {
-    char name[32];
-    snprintf(name, sizeof name, "starts[%d]", i);
-    LC_TRY(lc_check_vec(w, starts[i], 1e9, name));
-    snprintf(name, sizeof name, "ends[%d]", i);
-    LC_TRY(lc_check_vec(w, ends[i], 1e9, name));
-    if (starts[i].x == ends[i].x && starts[i].y == ends[i].y)
-        return lc_fail(w, LC_ERR_OUT_OF_RANGE, "ray %d has zero length (start = end = (%g, %g))", i, starts[i].x,
-                       starts[i].y);
-    return LC_OK;
+    char start_name[32], end_name[32], what[32];
+    snprintf(start_name, sizeof start_name, "starts[%d]", i);
+    snprintf(end_name, sizeof end_name, "ends[%d]", i);
+    snprintf(what, sizeof what, "ray %d", i);
+    return check_segment(w, starts[i], ends[i], start_name, end_name, what);
 }
 
 static void extend_box(double box[4], lc_vec2 p)
@@ -349,20 +367,11 @@ lc_status lc_world_ray_cast_batch(const lc_world *world, const lc_vec2 *starts, 
     }
     for (i = 0; i < count; ++i) {
         lc_vec2 d = lc_sub(ends[i], starts[i]);
-        double span[4] = {INFINITY, INFINITY, -INFINITY, -INFINITY};
+        double span[4];
         first_hit fh;
-        extend_box(span, starts[i]);
-        extend_box(span, ends[i]);
+        segment_box(starts[i], ends[i], span);
         fh.found = 0;
-        for (k = 0; k < nrows; ++k) {
-            polygon p;
-            lc_ray_hit hit;
-            if (!boxes_overlap(bounds + 4 * k, span)) continue;
-            world_polygon(w, rows[k], &p);
-            if (!ray_polygon(&p, starts[i], d, &hit)) continue;
-            hit.body = w->ids[rows[k]];
-            keep_first(&hit, &fh);
-        }
+        for (k = 0; k < nrows; ++k) cast_row(w, rows[k], bounds + 4 * k, span, starts[i], d, keep_first, &fh);
         out_found[i] = fh.found;
         if (fh.found) out_hits[i] = fh.best;
     }
