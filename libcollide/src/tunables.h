@@ -154,8 +154,16 @@
 #ifndef LC_CONTACT_PROJECTION_SLACK
 #define LC_CONTACT_PROJECTION_SLACK 4e-10
 #endif
+/* m, the projection's slack in an island of at least LC_CONTACT_LARGE_ISLAND_BODIES bodies: a pile that
+ * large settles with its flow a millimetre deep every step (Gauss-Seidel stalls in its height), and
+ * projecting that to 4e-10 m took the passes' second and third solves, a third of such a step's
+ * instructions (a settling 1 000-box pile, callgrind); 1e-7 m is ten times inside the 1e-6 m the contact
+ * scenes are held to (bench/contact.py), and 1e-6 m of lift is 1e-5 J per kilogram at g. */
+#define LC_CONTACT_PROJECTION_LARGE_SLACK 1e-7
+#define LC_CONTACT_LARGE_ISLAND_BODIES 300
 /* m, the overlap a contact-regime step may leave after its projection before the island is taken again
- * in the event regime: the test suites' 1e-9 m, ten times the projection's own aim. */
+ * in the event regime: the test suites' 1e-9 m, ten times the projection's own aim (in a large island
+ * ten times its slack). */
 #define LC_CONTACT_OVERLAP_LEFT 1e-9
 /* The energy gain, relative to an island's energy (the sum of its terms' magnitudes), a contact-regime
  * step may leave when the island's kinetic energy cannot pay for it before the island is taken again
@@ -185,6 +193,13 @@
  * them then keeping a gain above 1e-9 of the energy (bench/contact.py drop12). */
 #define LC_CONTACT_PROJECTION_PASS_TOLERANCE 1e-3
 #define LC_CONTACT_PROJECTION_LARGE 1000
+/* A projection pass of at least this many points starts from active sets over a sparse factorization
+ * (projection_active_set.h), whose cost does not grow with a pile's height; below it the sweeps usually
+ * converge and cost less (from 256 points up, a box dropped on a base-12 pyramid took 20 % more
+ * instructions and one step kept an energy gain of 1.2e-9, bench/contact.py drop12). */
+#ifndef LC_CONTACT_PROJECTION_DIRECT_ROWS   /* -D to measure */
+#define LC_CONTACT_PROJECTION_DIRECT_ROWS 1000
+#endif
 
 /* ---- contact forces and impulses (contact_forces.c, impulse.c) ---------------------------------- */
 
