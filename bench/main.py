@@ -4,7 +4,8 @@ error on the seed and hard-case scenes (docs/benchmarks.md). Use bench/run (it i
     bench/run [--quick | --full] [--sections wp,ref,impacts,cradle,tunnel,stacks,hard,pyramid,scaling]
     bench/run [--quick] --sections contact    # piles, pushing, friction (bench/contact.py)
 
-Writes docs/benchmarks.md, docs/img/bench_*.png and bench/results/latest.json. The contact section is
+Writes docs/benchmarks.md, docs/img/bench_*.png and bench/results/latest.json (and the results behind each
+page it writes: bench/results/benchmarks.json, bench_contact.json). The contact section is
 not in the default list; it writes docs/bench_contact.md, and docs/benchmarks.md only when other
 sections ran too (a run of it alone leaves that page as it is)."""
 from __future__ import annotations
@@ -390,21 +391,30 @@ def main() -> int:
         b.pool.close()
     b.out["meta"]["wall_s"] = time.time() - t0
     b.out["meta"]["load_after"] = os.getloadavg()
-    os.makedirs(os.path.join(HERE, "results"), exist_ok=True)
-    path = os.path.join(HERE, "results", "latest.json")
-    with open(path, "w") as f:
-        json.dump(b.out, f, indent=1, default=_json)
-    log(f"wrote {path}")
+    save_results(b.out, "latest.json")
     if not args.no_report:
         docs = os.path.dirname(os.path.abspath(args.out))
         if any(sec.strip() != "contact" for sec in args.sections.split(",")):
             report.write(b.out, args.out, os.path.join(docs, "img"))
             log(f"wrote {args.out}")
+            # the data behind this page's figures, kept until the page is written again
+            # (python bench/report.py --replot redraws them from it)
+            save_results(b.out, os.path.splitext(os.path.basename(args.out))[0] + ".json")
         if "contact" in b.out:   # a page of its own: report.write rewrites the whole of args.out
             report.write_contact(b.out, os.path.join(docs, "bench_contact.md"))
             log(f"wrote {os.path.join(docs, 'bench_contact.md')}")
+            save_results(b.out, "bench_contact.json")
     log(f"done in {time.time() - t0:.0f} s")
     return 0
+
+
+def save_results(out: dict[str, Any], name: str) -> None:
+    """bench/results/<name>: the results dict of this run as JSON."""
+    os.makedirs(os.path.join(HERE, "results"), exist_ok=True)
+    path = os.path.join(HERE, "results", name)
+    with open(path, "w") as f:
+        json.dump(out, f, indent=1, default=_json)
+    log(f"wrote {path}")
 
 
 def _lc_build() -> str:

@@ -1,8 +1,15 @@
-"""docs/benchmarks.md and docs/img/bench_*.png from the results dict of bench/main.py."""
+"""docs/benchmarks.md and docs/img/bench_*.png from the results dict of bench/main.py.
+
+    python bench/report.py --replot [bench/results/benchmarks.json]   # redraw the page's figures only
+"""
 from __future__ import annotations
 
+import argparse
+import json
 import math
 import os
+import sys
+import tempfile
 from typing import Any
 
 import numpy as np
@@ -223,6 +230,7 @@ def write(out: dict[str, Any], path: str, img_dir: str) -> None:
           "bench/run --sections contact       # piles, pushing, friction: bench_contact.md (this page is left as it is)",
           "bench/run --lib /path/to/build     # measure the libcollide.so of another build (first argument)",
           "bench/run --budget 60              # CPU seconds per run before it is stopped",
+          "python bench/report.py --replot    # redraw this page's figures from bench/results/benchmarks.json, no new run",
           "```", "",
           "`bench/run` installs the pinned peers of `bench/requirements.txt` into the project venv "
           "(`.venv`, made by `scripts/setup`) on first use, then runs `nice python bench/main.py`.", ""]
@@ -807,3 +815,37 @@ def write_contact(out: dict[str, Any], path: str) -> None:
     L += [""] + contact_table(sec) + [""] + contact_notes(sec) + [""]
     with open(path, "w") as fh:
         fh.write("\n".join(L))
+
+
+def replot(out: dict[str, Any], img_dir: str) -> None:
+    """Redraw the figures of the sections in `out` into img_dir; the page itself is left as it is."""
+    with tempfile.TemporaryDirectory() as tmp:
+        write(out, os.path.join(tmp, "benchmarks.md"), img_dir)
+
+
+def main() -> int:
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    ap = argparse.ArgumentParser(description="Redraw docs/img/bench_*.png from a stored bench/run result, "
+                                 "without running the benchmarks again.")
+    ap.add_argument("--replot", nargs="?", const=os.path.join(root, "bench", "results", "benchmarks.json"),
+                    metavar="JSON", required=True,
+                    help="results file written by bench/run (default bench/results/benchmarks.json)")
+    ap.add_argument("--img-dir", default=os.path.join(root, "docs", "img"), help="where the figures go")
+    args = ap.parse_args()
+    if not os.path.exists(args.replot):
+        print(f"report.py: no {args.replot}: run bench/run first (it keeps the results of the run that wrote "
+              "docs/benchmarks.md there)", file=sys.stderr)
+        return 1
+    with open(args.replot) as fh:
+        out = json.load(fh)
+    if not any(k in out for k in ("wp", "ref", "scaling")):
+        print(f"report.py: {args.replot} holds no section with figures (wp, ref, scaling)", file=sys.stderr)
+        return 1
+    replot(out, args.img_dir)
+    print(f"report.py: figures of {', '.join(k for k in ('wp', 'ref', 'scaling') if k in out)} "
+          f"from {out.get('meta', {}).get('date', '?')} redrawn into {args.img_dir}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -4,13 +4,19 @@ It installs the Python package collide_ros/ with the live view's page, the ament
 package.xml, and one console script per tool into lib/collide_ros/ (setup.cfg), where `ros2 run
 collide_ros <tool>` finds it. The binding `collide` in the same directory is not part of it: it
 needs the C library, and comes from `pip install` of the repository root (pyproject.toml)."""
+import re
+from pathlib import Path
+
 from setuptools import find_packages, setup
 
 PACKAGE = "collide_ros"
+# the version is written once for this package, in package.xml (which repeats CMake's project(VERSION);
+# tests/python/test_versions.py checks that they agree)
+VERSION = re.search(r"<version>([^<]+)</version>", (Path(__file__).parent / "package.xml").read_text()).group(1)
 
 setup(
     name=PACKAGE,
-    version="0.1.0",
+    version=VERSION,
     packages=find_packages(include=[PACKAGE, f"{PACKAGE}.*"]),
     package_data={f"{PACKAGE}.view": ["page.html"]},
     data_files=[

@@ -201,7 +201,7 @@ class Body:
         return Thruster(self, int(idx[0]))
 
     def add_default_thrusters(self, thrust: float = 1.5) -> list["Thruster"]:
-        """The seed's four: 0 left, 1 right, 2 up, 3 down (keys S,F,E,D / J,L,I,K)."""
+        """myPhysicsLab's four: 0 left, 1 right, 2 up, 3 down (keys S,F,E,D / J,L,I,K)."""
         first = ffi.new("int *")
         check(self._w, lib.lc_body_add_default_thrusters(self._w, self.id, cv.real(thrust, "thrust"), first))
         return [Thruster(self, int(first[0]) + i) for i in range(4)]

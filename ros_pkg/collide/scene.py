@@ -1,5 +1,5 @@
 """Scene files (YAML or JSON; format in docs/scene_format.md), strict validation, and the embedded
-default scene that reproduces the seed page's demo."""
+default scene that reproduces myPhysicsLab's demo."""
 from __future__ import annotations
 
 import copy
@@ -622,7 +622,7 @@ _BLOCK_POSES = ((-2.5, 0.0, 0.0), (2.5, 0.0, 0.0), (0.0, 3.5, math.pi / 2), (0.0
 
 def default_scene(blocks: int = 2, green_mass: float = 1.0, gravity: float = 0.0, elasticity: float = 1.0,
                   damping: float = 0.0) -> Scene:
-    """The seed page's demo: a walled box [-6, 6]^2 (1 m walls), 1-6 blocks 1 m x 3 m; block1 (green)
+    """myPhysicsLab's demo: a walled box [-6, 6]^2 (1 m walls), 1-6 blocks 1 m x 3 m; block1 (green)
     has the adjustable mass, the others 1 kg; default thrusters (thrust 1.5) on block1 and block2;
     gravity (m/s^2, downward), elasticity for every body, damping k with rotation ratio 0.1."""
     if isinstance(blocks, bool) or not isinstance(blocks, int) or not 1 <= blocks <= 6:

@@ -7,7 +7,7 @@
    exported one) with ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST;
 2. starts the recorder (subprocess) writing out/demo_bag (rosbag2, MCAP, metadata v9);
 3. drives the node from this process over ROS topics with a scripted thrust + spring
-   sequence timed in sim time (~10 s): ThrusterCommand on `thrusters` (the seed's F, I, E, S
+   sequence timed in sim time (~10 s): ThrusterCommand on `thrusters` (myPhysicsLab's F, I, E, S
    keys), a world-frame push on `block1/thrust`, a mouse spring dragged on `spring`, a
    torque on `block2/thrust`, Twists on `cmd_vel` (block2, as teleop_twist_keyboard sends
    them), then a free coast with no forces;
@@ -63,7 +63,7 @@ class Cue:
 
 SPRING_BODY = "block1"
 SPRING_POINT = (0.5, 1.5)    # body frame, about the centre of mass: the top-right corner
-SPRING_K = 3.0               # N/m, the seed's mouse spring
+SPRING_K = 3.0               # N/m, myPhysicsLab's mouse spring
 COAST_FROM = 7.0             # s: no force acts from here on (energy must stay constant)
 
 

@@ -4,7 +4,7 @@
 
 Each frame shows the walls, the bodies (block1 green), the contact points reported since
 the previous frame (red = collision, orange = resting), the spring as a line from its body
-point to its target, and an energy bar graph like the seed page's: translational,
+point to its target, and an energy bar graph like myPhysicsLab's: translational,
 rotational and potential (gravitational + spring) energy stacked, with the total.
 Body shapes are not in the bag's messages; they come from the scene (the embedded default
 scene unless shapes are given).

@@ -1,4 +1,4 @@
-"""Keyboard teleop for the sim node: the seed page's thruster keys over ROS.
+"""Keyboard teleop for the sim node: myPhysicsLab's thruster keys over ROS.
 
     python -m collide_ros.teleop [--rate 20] [--hold 0.15] [--first-hold 0.6]
     python -m collide_ros.teleop --keys "eeeff[up]" --interval 0.05     # non-interactive

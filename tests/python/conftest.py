@@ -10,6 +10,7 @@ from __future__ import annotations
 import os
 import sys
 from pathlib import Path
+from typing import Iterator
 
 import pytest
 
@@ -58,3 +59,15 @@ def ros_domain_id() -> int:
 @pytest.fixture(scope="session")
 def repo_root() -> Path:
     return ROOT
+
+
+@pytest.fixture(scope="module")
+def ros() -> Iterator[None]:
+    """rclpy initialised for one test module (on this process's locked ROS_DOMAIN_ID), shut down after it."""
+    import rclpy  # here, not at the top: pytest_configure sets the ROS environment first
+
+    rclpy.init()
+    try:
+        yield
+    finally:
+        rclpy.try_shutdown()

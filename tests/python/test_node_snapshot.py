@@ -6,11 +6,9 @@ from __future__ import annotations
 import json
 import os
 from itertools import count
-from typing import Iterator
 
 import numpy as np
 import pytest
-import rclpy
 from geometry_msgs.msg import Point, Pose, Twist, WrenchStamped
 from libcollide_msgs.msg import SpringCommand, ThrusterCommand
 from libcollide_msgs.srv import Spawn
@@ -19,15 +17,7 @@ from rclpy.parameter import Parameter
 from collide_ros.node import SimNode
 
 _ns = count()
-
-
-@pytest.fixture(scope="module", autouse=True)
-def ros() -> Iterator[None]:
-    rclpy.init()
-    try:
-        yield
-    finally:
-        rclpy.try_shutdown()
+pytestmark = pytest.mark.usefixtures("ros")  # rclpy for every test (conftest.py)
 
 
 def make_node() -> SimNode:

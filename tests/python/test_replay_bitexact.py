@@ -8,10 +8,8 @@ import os
 import subprocess
 import sys
 from pathlib import Path
-from typing import Iterator
 
 import pytest
-import rclpy
 
 from collide_ros.recorder import make_typestore
 from collide_ros.replay import Command, iter_commands, iter_states, replay
@@ -27,15 +25,6 @@ def bag(tmp_path_factory: pytest.TempPathFactory) -> Path:
                         "--no-gif"], capture_output=True, text=True, timeout=GIVE_UP, env=dict(os.environ))
     assert r.returncode == 0, r.stdout + r.stderr
     return out / "demo_bag"
-
-
-@pytest.fixture()
-def ros() -> Iterator[None]:
-    rclpy.init()
-    try:
-        yield
-    finally:
-        rclpy.try_shutdown()
 
 
 def _commands(bag: Path) -> list[Command]:

@@ -10,7 +10,7 @@ import subprocess
 import sys
 import time
 from pathlib import Path
-from typing import Callable, Iterator
+from typing import Callable
 
 import pytest
 import rclpy
@@ -30,15 +30,6 @@ STATES_TYPE = "libcollide_msgs/msg/BodyStates"
 
 GIVE_UP = 120.0  # s: guards against a hang only
 LONG_RUN = 20.0  # s of sim time the node runs before the recording starts
-
-
-@pytest.fixture(scope="module")
-def ros() -> Iterator[None]:
-    rclpy.init()
-    try:
-        yield
-    finally:
-        rclpy.try_shutdown()
 
 
 def _record(tmp: Path, node_args: list[str], sim_seconds: float, wait_sim: float = 0.0) -> Path:
