@@ -119,20 +119,27 @@ static void dense_solve(const double *a, int m, const unsigned char *act, const 
     free(y);
 }
 
-static void grid_problem(problem *p, int side, unsigned long long *seed)
+/* nb bodies of random mass in [lo, hi] kg, inertia mass * r2, room for cap rows */
+static void new_problem(problem *p, int nb, int cap, double lo, double hi, double r2, unsigned long long *seed)
 {
-    int i, j, cap = side * side * 6 + side;
-    p->nb = side * side;
+    int i;
+    p->nb = nb;
     p->m = 0;
     p->rows = calloc((size_t)cap, sizeof(lc_contact_row));
     p->xy = calloc((size_t)cap * 2, sizeof(double));
-    p->inv_mass = calloc((size_t)p->nb, sizeof(double));
-    p->inv_inertia = calloc((size_t)p->nb, sizeof(double));
-    for (i = 0; i < p->nb; ++i) {
-        double mass = 0.5 + 4.5 * uniform(seed);
+    p->inv_mass = calloc((size_t)nb, sizeof(double));
+    p->inv_inertia = calloc((size_t)nb, sizeof(double));
+    for (i = 0; i < nb; ++i) {
+        double mass = lo + (hi - lo) * uniform(seed);
         p->inv_mass[i] = 1.0 / mass;
-        p->inv_inertia[i] = 1.0 / (mass / 6.0);
+        p->inv_inertia[i] = 1.0 / (mass * r2);
     }
+}
+
+static void grid_problem(problem *p, int side, unsigned long long *seed)
+{
+    int i, j;
+    new_problem(p, side * side, side * side * 6 + side, 0.5, 5.0, 1.0 / 6.0, seed);
     for (i = 0; i < side; ++i)
         for (j = 0; j < side; ++j) {
             int k = i * side + j, c;
@@ -148,18 +155,8 @@ static void grid_problem(problem *p, int side, unsigned long long *seed)
 /* layers x width boxes 1 m x 0.5 m, odd layers shifted by half a box; rows on their supports (normal +y) */
 static void brick_problem(problem *p, int layers, int width, unsigned long long *seed)
 {
-    int i, j, cap = layers * width * 8;
-    p->nb = layers * width;
-    p->m = 0;
-    p->rows = calloc((size_t)cap, sizeof(lc_contact_row));
-    p->xy = calloc((size_t)cap * 2, sizeof(double));
-    p->inv_mass = calloc((size_t)p->nb, sizeof(double));
-    p->inv_inertia = calloc((size_t)p->nb, sizeof(double));
-    for (i = 0; i < p->nb; ++i) {
-        double mass = 1.0 + 9.0 * uniform(seed);
-        p->inv_mass[i] = 1.0 / mass;
-        p->inv_inertia[i] = 12.0 / (mass * 1.25);
-    }
+    int i, j;
+    new_problem(p, layers * width, layers * width * 8, 1.0, 10.0, 1.25 / 12.0, seed);
     for (i = 0; i < layers; ++i)
         for (j = 0; j < width; ++j) {
             int k = i * width + j, q;
@@ -350,8 +347,12 @@ static void check_start(void)
     CHECK(from_zero > 0 && from_start > 0 && from_start < from_zero, "sweeps from the start %d, from no push %d",
           from_start, from_zero);
     CHECK(dmax <= 1e-9, "displacements differ by %.3g", dmax);
-    printf("brick wall, %d rows: the set %s (%d), Gauss-Seidel %d sweeps from the start, %d from no push\n", p.m,
-           rounds > 0 ? "settled in rounds" : "did not settle", rounds, from_start, from_zero);
+    if (rounds > 0)
+        printf("brick wall, %d rows: the set settled in %d rounds; Gauss-Seidel %d sweeps from the start, %d from no push\n",
+               p.m, rounds, from_start, from_zero);
+    else
+        printf("brick wall, %d rows: the set did not settle; Gauss-Seidel %d sweeps from the start, %d from no push\n", p.m,
+               from_start, from_zero);
     lc_projection_active_set_destroy(ps);
     free_problem(&p);
     free(b); free(lambda); free(d0); free(d1);
