@@ -13,12 +13,34 @@ struct lc_event_crossings {
     lc_buf pairs;             /* the broad phase's pairs of the interval */
     lc_buf cross;             /* the crossings (count of them after the last search) */
     int count;
-    lc_buf coupled, keys;     /* bodies that touch another or are tied by a spring; drop_resting_drift's table */
+    lc_buf coupled, keys;     /* stamps of the bodies that touch another or are tied to one; drop_resting_drift's table */
+    unsigned coupled_now;     /* coupled[row] == coupled_now: coupled in this search (older stamps: not) */
+    int coupled_rows;         /* the rows coupled was cleared for (-1: none yet) */
     lc_buf sample0, sample1;  /* the swept check: an uncoupled pair's states at two sub-times */
     lc_buf samples;           /* and the whole world's at every sub-time */
 };
 
-lc_event_crossings *lc_event_crossings_create(void) { return calloc(1, sizeof(lc_event_crossings)); }
+lc_event_crossings *lc_event_crossings_create(void)
+{
+    lc_event_crossings *ec = calloc(1, sizeof(lc_event_crossings));
+    if (ec != NULL) ec->coupled_rows = -1;
+    return ec;
+}
+
+/* Stamps the bodies that touch another or are tied to another (coupled[row] = mark). */
+static void mark_coupled(lc_world *w, unsigned *coupled, const lc_trial *tr, unsigned mark)
+{
+    int i;
+    for (i = 0; i < tr->nrest; ++i) coupled[tr->rest[i].a] = coupled[tr->rest[i].b] = mark;
+    for (i = 0; i < w->spring_count; ++i)
+        if (w->springs[i].def.body_b != LC_WORLD_ANCHOR) {
+            coupled[lc_world_body_index(w, w->springs[i].def.body_a)] = mark;
+            coupled[lc_world_body_index(w, w->springs[i].def.body_b)] = mark;
+        }
+    /* the force callback may tie any body to any other */
+    if (lc_force_callback_on(w))
+        for (i = 0; i < w->count; ++i) coupled[i] = mark;
+}
 
 void lc_event_crossings_destroy(lc_event_crossings *ec)
 {
@@ -139,7 +161,8 @@ static double circle_gap(const lc_world *w, const double *s, int a, int b)
  * a contact-force solve of the whole pile per integrator stage, and a settling 1275-box pyramid has
  * hundreds of near pairs in one interval. */
 static int swept_check(lc_world *w, lc_event_crossings *ec, const double *s0, const double *s1, double h,
-                       const int *pairs, int np, int nc, const int *coupled, const int *all_rows, int n_all,
+                       const int *pairs, int np, int nc, const unsigned *coupled, unsigned coupled_now,
+                       const int *all_rows, int n_all,
                        lc_touch *rest, int nrest)
 {
     size_t count6 = (size_t)w->count * 6, bytes = count6 * sizeof(double);
@@ -177,7 +200,7 @@ static int swept_check(lc_world *w, lc_event_crossings *ec, const double *s0, co
             continue;
         if (!w->is_static[a]) rows[nr++] = a;
         if (!w->is_static[b]) rows[nr++] = b;
-        uncoupled = !coupled[a] && !coupled[b];
+        uncoupled = coupled[a] != coupled_now && coupled[b] != coupled_now;
         prev = s0;
         for (k = 1; k <= LC_SWEEP_SAMPLES; ++k) {
             double tk = h * k / LC_SWEEP_SAMPLES;
@@ -225,7 +248,8 @@ static int swept_check(lc_world *w, lc_event_crossings *ec, const double *s0, co
 int lc_event_crossings_find(lc_world *w, lc_event_crossings *ec, const lc_trial *tr, const lc_moved *moved,
                             const lc_crossing *stalled, int nstalled, lc_crossing **out)
 {
-    int np, nc = 0, nkept = 0, i, *coupled;
+    int np, nc = 0, nkept = 0, i;
+    unsigned *coupled;
     const int *pairs;
     if (moved != NULL) {
         nc = nkept = keep_clean_crossings(ec, moved->marked, moved->since);
@@ -246,20 +270,19 @@ int lc_event_crossings_find(lc_world *w, lc_event_crossings *ec, const lc_trial 
     if (nc < 0) return -1;
     /* a body touching nothing and tied by no spring (nor force callback) to another body moves on its
      * own: its time-of-impact evaluations (and swept samples) need only the two bodies */
-    coupled = lc_buf_get(&ec->coupled, (size_t)w->count * sizeof(int));
+    coupled = lc_buf_get(&ec->coupled, (size_t)(w->count > 0 ? w->count : 1) * sizeof(unsigned));
     if (coupled == NULL) return -1;
-    memset(coupled, 0, (size_t)w->count * sizeof(int));
-    for (i = 0; i < tr->nrest; ++i) coupled[tr->rest[i].a] = coupled[tr->rest[i].b] = 1;
-    for (i = 0; i < w->spring_count; ++i)
-        if (w->springs[i].def.body_b != LC_WORLD_ANCHOR) {
-            coupled[lc_world_body_index(w, w->springs[i].def.body_a)] = 1;
-            coupled[lc_world_body_index(w, w->springs[i].def.body_b)] = 1;
-        }
-    /* the force callback may tie any body to any other */
-    if (lc_force_callback_on(w))
-        for (i = 0; i < w->count; ++i) coupled[i] = 1;
+    /* a new stamp per search: clearing every mark at each search was a pass over the world per
+     * impact. All of them only for another world size, or when the stamps wrap. */
+    if (ec->coupled_rows != w->count || ++ec->coupled_now == 0) {
+        memset(coupled, 0, (size_t)w->count * sizeof(unsigned));
+        ec->coupled_rows = w->count;
+        ec->coupled_now = 1;
+    }
+    mark_coupled(w, coupled, tr, ec->coupled_now);
     for (i = nkept; i < nc; ++i) ((lc_crossing *)ec->cross.p)[i].t_hi = tr->h;
-    nc = swept_check(w, ec, tr->s0, tr->s1, tr->h, pairs, np, nc, coupled, tr->rows, tr->nrows, tr->rest, tr->nrest);
+    nc = swept_check(w, ec, tr->s0, tr->s1, tr->h, pairs, np, nc, coupled, ec->coupled_now, tr->rows, tr->nrows,
+                     tr->rest, tr->nrest);
     if (nc < 0) return -1;
     *out = (lc_crossing *)ec->cross.p;
     ec->count = nc;
