@@ -14,7 +14,8 @@
  * pairs of lc_broad_phase_of (the pairs of a few listed bodies, after an impact) equal brute force's
  * pairs that have a listed body, also while the broad phase tracks an interval in its grid
  * (lc_broad_phase_track): at a state inside the interval, and after a hundred bodies changed paths
- * (lc_broad_phase_retrack, past the share of moved bodies at which the grid is built anew). */
+ * (lc_broad_phase_retrack: their new boxes in the cells' lists beside the table), and after every path
+ * changed three times more (past the entries at which the grid is built anew). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -177,6 +178,11 @@ int main(void)
             for (k = 1; k <= 100; k++) s2[k * 6 + SY] += sc_uniform(&rng, -3.0, 3.0);
             CHECK(lc_broad_phase_retrack(w, sm, s2, 0.0, dyn, 100, w->def.contact_distance) == 0, "%s", "retrack");
             compare_of(w, sm, s2, "tracked, 100 paths changed", brute, sweep, &rng);
+            for (i = 0; i < 3; i++) {
+                for (k = 1; k < rows; k++) s2[k * 6 + SX] += sc_uniform(&rng, -1.0, 1.0);
+                CHECK(lc_broad_phase_retrack(w, sm, s2, 0.0, dyn, nd, w->def.contact_distance) == 0, "%s", "retrack all");
+                compare_of(w, sm, s2, "tracked, all paths changed", brute, sweep, &rng);
+            }
             lc_broad_phase_untrack(w);
             CHECK(lc_broad_phase_near(w, &s0[0], &near) == -2, "%s", "nothing is tracked after untrack");
         }
