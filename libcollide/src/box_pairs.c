@@ -97,6 +97,11 @@ int lc_box_pairs_find(lc_box_pairs *g, const void *boxes, size_t stride, int n,
         small++;
     }
     if (small == 0) xmin = ymin = xmax = ymax = 0.0;
+    if (!(xmax - xmin < INFINITY && ymax - ymin < INFINITY)) {
+        /* finite boxes farther apart than a double spans: no grid, every box against every box */
+        for (k = 0; k < n; ++k) kind[k] = ODD;
+        xmin = ymin = xmax = ymax = 0.0;
+    }
     for (;;) {
         double nxd = floor((xmax - xmin) / cell) + 1.0, nyd = floor((ymax - ymin) / cell) + 1.0;
         if (nxd * nyd <= 4.0 * n + 16.0) {

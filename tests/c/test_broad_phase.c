@@ -55,7 +55,8 @@ static void compare(lc_world *w, const double *s0, const double *s1, const char 
 
 /* Given boxes (lc_broad_phase_boxes) with a few no grid cell can hold: a NaN box (meets none), an
  * infinite strip (meets every box in its band), an inverted box (x0 > x1: meets a box that spans it
- * under the closed-interval test) and a point; the grid must list brute force's pairs. */
+ * under the closed-interval test), a point, and two boxes near -1e308 and 1e308 (their distance is no
+ * double); the grid must list brute force's pairs. */
 static void compare_odd_boxes(lc_world *w, const double *s0, int *brute, int *grid)
 {
     int n = w->count, i, nb, ng;
@@ -68,6 +69,8 @@ static void compare_odd_boxes(lc_world *w, const double *s0, int *brute, int *gr
     b4[4 * 2 + 0] = -INFINITY; b4[4 * 2 + 2] = INFINITY; b4[4 * 2 + 1] = 2.0; b4[4 * 2 + 3] = 2.5;
     b4[4 * 3 + 0] = 5.0; b4[4 * 3 + 2] = 4.0; b4[4 * 3 + 1] = 0.0; b4[4 * 3 + 3] = 8.0;
     b4[4 * 4 + 0] = b4[4 * 4 + 2] = 1.0; b4[4 * 4 + 1] = b4[4 * 4 + 3] = 1.0;
+    b4[4 * 5 + 0] = b4[4 * 5 + 2] = -1e308;   /* small and finite, but farther apart than a double spans */
+    b4[4 * 6 + 0] = b4[4 * 6 + 2] = 1e308;
     w->def.broadphase = LC_BROADPHASE_BRUTE_FORCE;
     nb = lc_broad_phase_boxes(w, b4, &buf);
     if (nb > 0) memcpy(brute, buf.p, (size_t)nb * 2 * sizeof(int));
