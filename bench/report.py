@@ -24,6 +24,7 @@ STAGES = [("force_evaluations", "ODE integrator (force evaluations)"),
           ("analytic_advances", "closed-form free flight"),
           ("brute_force_steps", "broadphase: brute force"),
           ("sort_and_sweep_steps", "broadphase: sort-and-sweep"),
+          ("grid_steps", "broadphase: grid"),
           ("toi_searches", "time-of-impact search"),
           ("impulse_solves", "impulse solve (eq. 11)"),
           ("serial_iterations", "serial impact passes"),
@@ -107,6 +108,13 @@ def plot_wp(rows: list[dict[str, Any]], title: str, path: str, key: str = "abs_d
     plt.close(fig)
 
 
+def broadphase_used(stages: dict) -> str:
+    """The broadphase that did most of a run's whole-world pair searches (its counters)."""
+    counts = {"brute force": stages.get("brute_force_steps", 0), "sort-and-sweep": stages.get("sort_and_sweep_steps", 0),
+              "grid": stages.get("grid_steps", 0)}
+    return max(counts, key=lambda k: counts[k])
+
+
 def plot_scaling(rows: list[dict[str, Any]], path: str) -> None:
     plt = _plt()
     fig, ax = plt.subplots(figsize=(7.5, 5.2), dpi=110)
@@ -118,14 +126,14 @@ def plot_scaling(rows: list[dict[str, Any]], path: str) -> None:
         ax.plot([r["n"] for r in rs], [r["us_per_step"] for r in rs], "-", color=COLORS[eng], label=NAMES[eng])
         if eng == "libcollide":
             for r in rs:
-                st = r.get("stages", {})
-                sas = st.get("sort_and_sweep_steps", 0) > st.get("brute_force_steps", 0)
-                ax.plot(r["n"], r["us_per_step"], "s" if sas else "o", color=COLORS[eng],
-                        mfc="white" if sas else COLORS[eng])
+                bp = broadphase_used(r.get("stages", {}))
+                ax.plot(r["n"], r["us_per_step"], {"grid": "D", "sort-and-sweep": "s"}.get(bp, "o"),
+                        color=COLORS[eng], mfc=COLORS[eng] if bp == "brute force" else "white")
         else:
             ax.plot([r["n"] for r in rs], [r["us_per_step"] for r in rs], ".", color=COLORS[eng])
     ax.plot([], [], "o", color=COLORS["libcollide"], label="libcollide: brute-force broadphase")
     ax.plot([], [], "s", color=COLORS["libcollide"], mfc="white", label="libcollide: sort-and-sweep broadphase")
+    ax.plot([], [], "D", color=COLORS["libcollide"], mfc="white", label="libcollide: grid broadphase")
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.set_xlabel("dynamic bodies (seed blocks, e = 1, g = 0, constant crowding)")
@@ -540,7 +548,8 @@ def write(out: dict[str, Any], path: str, img_dir: str) -> None:
         L += ["## Scaling: step cost against body count", "",
               "Seed blocks (e = 1, g = 0, random velocities) in a walled box sized to keep the seed scene's "
               "crowding, 1 s at dt 1/60. libcollide's markers show the broadphase it chose "
-              "(`world.counters()`: brute_force_steps vs sort_and_sweep_steps; AUTO switches at 32 bodies).", "",
+              "(`world.counters()`: brute_force_steps, sort_and_sweep_steps, grid_steps; AUTO uses sort-and-sweep "
+              "from 32 bodies and the grid from 4 096).", "",
               f"![scaling]({rel}/bench_scaling.png)", "",
               "| bodies | " + " | ".join(NAMES[e] + " µs/step" for e in ENGINES) + " | libcollide broadphase | "
               "libcollide body advances per step |", "|---|" + "---|" * (len(ENGINES) + 2)]
@@ -551,8 +560,7 @@ def write(out: dict[str, Any], path: str, img_dir: str) -> None:
                 cells.append("—" if r is None else f"{f(r.get('us_per_step'))}{status_cell(r)}")
             lc = next((r for r in sc if r["n"] == n and r["engine"] == "libcollide"), None)
             st = (lc or {}).get("stages") or {}
-            bp = "sort-and-sweep" if st.get("sort_and_sweep_steps", 0) > st.get("brute_force_steps", 0) else \
-                ("brute force" if st else "—")
+            bp = broadphase_used(st) if st else "—"
             adv = f"{st.get('analytic_advances', 0) / max(st.get('steps', 1), 1):.3g}" if st else "—"
             name = "0 (one static box: the per-step floor of engine + binding)" if n == 0 else str(n)
             L.append(f"| {name} | " + " | ".join(cells) + f" | {bp} | {adv} |")

@@ -450,7 +450,7 @@ static void fz_set_def(fz_in *in, lc_world_def *d)
         case 18: d->lcp_exact_max = fz_int(in, 0, 256); break;
         case 19: d->lcp_max_iterations = fz_int(in, 1, 500); break;
         case 20: d->lcp_tolerance = fz_num(in, 0.0, 1e-6); break;
-        case 21: d->broadphase = (lc_broadphase)fz_int(in, 0, 2); break;
+        case 21: d->broadphase = (lc_broadphase)fz_int(in, 0, 3); break;
         case 22: d->broadphase_threshold = fz_int(in, 2, 16); break;
         default: d->gravity.y = -9.81; break;
         }

@@ -1,10 +1,13 @@
 /* Broad phase: candidate body pairs from swept bounding boxes. Brute force for a few bodies,
- * sort-and-sweep along x above broadphase_threshold (AUTO). */
+ * sort-and-sweep along x from broadphase_threshold, pairs from a uniform grid (box_pairs.c) from
+ * LC_GRID_MIN_ROWS (AUTO); all three find the same pairs in the same order. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 #include "world.h"
 #include "reach_grid.h"
+#include "box_pairs.h"
+#include "tunables.h"
 
 typedef struct box { double x0, y0, x1, y1; int row; } box;
 
@@ -15,6 +18,7 @@ struct lc_broad_phase_state {
      * counting sort of the pairs */
     lc_buf sweep_order, sweep_boxes, pair_start, pair_tmp;
     int sweep_rows;
+    lc_box_pairs *grid_pairs;      /* the grid search's scratch */
     /* lc_broad_phase_track: where each body can be during the trial interval, in a grid, while tracked */
     lc_reach_grid *grid;
     int tracked;
@@ -27,7 +31,10 @@ lc_broad_phase_state *lc_broad_phase_state_create(void)
     lc_broad_phase_state *bp = calloc(1, sizeof(lc_broad_phase_state));
     if (bp == NULL) return NULL;
     bp->grid = lc_reach_grid_create();
-    if (bp->grid == NULL) {
+    bp->grid_pairs = lc_box_pairs_create();
+    if (bp->grid == NULL || bp->grid_pairs == NULL) {
+        lc_reach_grid_destroy(bp->grid);
+        lc_box_pairs_destroy(bp->grid_pairs);
         free(bp);
         return NULL;
     }
@@ -49,6 +56,7 @@ void lc_broad_phase_state_destroy(lc_broad_phase_state *bp)
     lc_buf_free(&bp->track_rows);
     lc_buf_free(&bp->box_stamp);
     lc_reach_grid_destroy(bp->grid);
+    lc_box_pairs_destroy(bp->grid_pairs);
     free(bp);
 }
 
@@ -238,13 +246,44 @@ static void bound_box(const lc_world *w, const double *s0, const double *s1, int
     out->row = i;
 }
 
+/* lc_box_pairs_find's keep: an overlapping pair of boxes is a candidate unless both bodies are static
+ * or one is excluded (add_if_near's rules). */
+typedef struct grid_keep { lc_world *w; lc_buf *buf; int count; } grid_keep;
+
+static int keep_grid_pair(void *ctx, int a, int b)
+{
+    grid_keep *k = ctx;
+    const lc_world *w = k->w;
+    if (w->is_static[a] && w->is_static[b]) return 0;
+    if (w->excluded && (w->excluded[a] || w->excluded[b])) return 0;
+    k->count = add_pair(k->buf, k->count, a, b);
+    return k->count < 0 ? -1 : 0;
+}
+
+/* The broadphase a search of n bodies uses. */
+static lc_broadphase choose(const lc_world *w, int n)
+{
+    if (w->def.broadphase != LC_BROADPHASE_AUTO) return w->def.broadphase;
+    if (n < w->def.broadphase_threshold) return LC_BROADPHASE_BRUTE_FORCE;
+    return n < LC_GRID_MIN_ROWS ? LC_BROADPHASE_SORT_AND_SWEEP : LC_BROADPHASE_GRID;
+}
+
 /* The candidate pairs of boxes[0..count) (indexed by row). */
 static int pairs_of(lc_world *w, box *boxes, lc_buf *buf)
 {
     int n = w->count, i, j, count = 0;
-    int use_sweep = w->def.broadphase == LC_BROADPHASE_SORT_AND_SWEEP ||
-                    (w->def.broadphase == LC_BROADPHASE_AUTO && n >= w->def.broadphase_threshold);
-    if (!use_sweep) {
+    lc_broadphase mode = choose(w, n);
+    if (mode == LC_BROADPHASE_GRID) {
+        grid_keep k;
+        k.w = w;
+        k.buf = buf;
+        k.count = 0;
+        w->last.grid_steps++;
+        if (lc_box_pairs_find(w->broad_phase->grid_pairs, boxes, sizeof(box), n, keep_grid_pair, &k) != 0) return -1;
+        count = k.count;
+        /* same pair order as brute force, so results do not depend on the broadphase */
+        if (count > 1 && order_pairs(w, (int *)buf->p, count) != 0) return -1;
+    } else if (mode != LC_BROADPHASE_SORT_AND_SWEEP) {
         w->last.brute_force_steps++;
         for (i = 0; i < n; ++i)
             for (j = i + 1; j < n; ++j)

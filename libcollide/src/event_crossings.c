@@ -13,12 +13,52 @@ struct lc_event_crossings {
     lc_buf pairs;             /* the broad phase's pairs of the interval */
     lc_buf cross;             /* the crossings (count of them after the last search) */
     int count;
-    lc_buf coupled, keys;     /* bodies that touch another or are tied by a spring; drop_resting_drift's table */
+    lc_buf coupled, keys;     /* stamps of the bodies that touch another or are tied to one; drop_resting_drift's table */
+    unsigned coupled_now;     /* coupled[row] == coupled_now: coupled in this search (older stamps: not) */
+    int coupled_rows;         /* the rows coupled was cleared for (-1: none yet) */
+    lc_buf in_cross;          /* the swept check's stamps of the bodies in a crossing, as coupled's */
+    unsigned in_cross_now;
+    int in_cross_rows;
     lc_buf sample0, sample1;  /* the swept check: an uncoupled pair's states at two sub-times */
     lc_buf samples;           /* and the whole world's at every sub-time */
 };
 
-lc_event_crossings *lc_event_crossings_create(void) { return calloc(1, sizeof(lc_event_crossings)); }
+lc_event_crossings *lc_event_crossings_create(void)
+{
+    lc_event_crossings *ec = calloc(1, sizeof(lc_event_crossings));
+    if (ec != NULL) ec->coupled_rows = ec->in_cross_rows = -1;
+    return ec;
+}
+
+/* A new stamp of a marks array of one unsigned per row (rows: the world size it was cleared for), or 0
+ * without memory. A new stamp per use instead of clearing every mark: that was a pass over the world
+ * per impact. All of them only for another world size, or when the stamps wrap. */
+static unsigned new_stamp(lc_buf *marks, unsigned *now, int *rows, int count)
+{
+    unsigned *m = lc_buf_get(marks, (size_t)(count > 0 ? count : 1) * sizeof(unsigned));
+    if (m == NULL) return 0;
+    if (*rows != count || ++*now == 0) {
+        memset(m, 0, (size_t)count * sizeof(unsigned));
+        *rows = count;
+        *now = 1;
+    }
+    return *now;
+}
+
+/* Stamps the bodies that touch another or are tied to another (coupled[row] = mark). */
+static void mark_coupled(lc_world *w, unsigned *coupled, const lc_trial *tr, unsigned mark)
+{
+    int i;
+    for (i = 0; i < tr->nrest; ++i) coupled[tr->rest[i].a] = coupled[tr->rest[i].b] = mark;
+    for (i = 0; i < w->spring_count; ++i)
+        if (w->springs[i].def.body_b != LC_WORLD_ANCHOR) {
+            coupled[lc_world_body_index(w, w->springs[i].def.body_a)] = mark;
+            coupled[lc_world_body_index(w, w->springs[i].def.body_b)] = mark;
+        }
+    /* the force callback may tie any body to any other */
+    if (lc_force_callback_on(w))
+        for (i = 0; i < w->count; ++i) coupled[i] = mark;
+}
 
 void lc_event_crossings_destroy(lc_event_crossings *ec)
 {
@@ -26,6 +66,7 @@ void lc_event_crossings_destroy(lc_event_crossings *ec)
     lc_buf_free(&ec->pairs);
     lc_buf_free(&ec->cross);
     lc_buf_free(&ec->coupled);
+    lc_buf_free(&ec->in_cross);
     lc_buf_free(&ec->keys);
     lc_buf_free(&ec->sample0);
     lc_buf_free(&ec->sample1);
@@ -139,22 +180,31 @@ static double circle_gap(const lc_world *w, const double *s, int a, int b)
  * a contact-force solve of the whole pile per integrator stage, and a settling 1275-box pyramid has
  * hundreds of near pairs in one interval. */
 static int swept_check(lc_world *w, lc_event_crossings *ec, const double *s0, const double *s1, double h,
-                       const int *pairs, int np, int nc, const int *coupled, const int *all_rows, int n_all,
+                       const int *pairs, int np, int nc, const unsigned *coupled, unsigned coupled_now,
+                       const int *all_rows, int n_all,
                        lc_touch *rest, int nrest)
 {
     size_t count6 = (size_t)w->count * 6, bytes = count6 * sizeof(double);
     double *own[2], *world_at = NULL;
     int have_world[LC_SWEEP_SAMPLES] = {0};
     int p, k, i;
+    unsigned now = new_stamp(&ec->in_cross, &ec->in_cross_now, &ec->in_cross_rows, w->count), *in_cross;
+    if (now == 0) return -1;
+    in_cross = (unsigned *)ec->in_cross.p;
+    /* the bodies of the crossings so far: a pair with a body in none has no crossing (the list of
+     * crossings need not be searched for each of the interval's pairs) */
+    for (i = 0; i < nc; ++i)
+        in_cross[((const lc_crossing *)ec->cross.p)[i].a] = in_cross[((const lc_crossing *)ec->cross.p)[i].b] = now;
     own[0] = own[1] = NULL;
     for (p = 0; p < np; ++p) {
         int a = pairs[2 * p], b = pairs[2 * p + 1], rows[2], nr = 0, have = 0, uncoupled;
         double dev, sep0;
         const double *prev, *cur;
-        for (i = 0; i < nc; ++i) {
-            const lc_crossing *c = &((const lc_crossing *)ec->cross.p)[i];
-            if ((c->a == a && c->b == b) || (c->a == b && c->b == a)) have = 1;
-        }
+        if (in_cross[a] == now && in_cross[b] == now)
+            for (i = 0; i < nc; ++i) {
+                const lc_crossing *c = &((const lc_crossing *)ec->cross.p)[i];
+                if ((c->a == a && c->b == b) || (c->a == b && c->b == a)) have = 1;
+            }
         /* the end-point test already bracketed this pair; if another vertex (a corner meeting a
          * corner) dipped in before that crossing's time, the pair's time of impact finds it */
         if (have) continue;
@@ -177,7 +227,7 @@ static int swept_check(lc_world *w, lc_event_crossings *ec, const double *s0, co
             continue;
         if (!w->is_static[a]) rows[nr++] = a;
         if (!w->is_static[b]) rows[nr++] = b;
-        uncoupled = !coupled[a] && !coupled[b];
+        uncoupled = coupled[a] != coupled_now && coupled[b] != coupled_now;
         prev = s0;
         for (k = 1; k <= LC_SWEEP_SAMPLES; ++k) {
             double tk = h * k / LC_SWEEP_SAMPLES;
@@ -213,7 +263,11 @@ static int swept_check(lc_world *w, lc_event_crossings *ec, const double *s0, co
             nc = lc_find_crossings(w, prev, cur, a, b, &ec->cross, nc);
             if (nc < 0) return -1;
             if (nc > before) {
-                for (i = before; i < nc; ++i) ((lc_crossing *)ec->cross.p)[i].t_hi = tk;
+                for (i = before; i < nc; ++i) {
+                    lc_crossing *c = &((lc_crossing *)ec->cross.p)[i];
+                    c->t_hi = tk;
+                    in_cross[c->a] = in_cross[c->b] = now;
+                }
                 break;
             }
             prev = cur;
@@ -225,7 +279,8 @@ static int swept_check(lc_world *w, lc_event_crossings *ec, const double *s0, co
 int lc_event_crossings_find(lc_world *w, lc_event_crossings *ec, const lc_trial *tr, const lc_moved *moved,
                             const lc_crossing *stalled, int nstalled, lc_crossing **out)
 {
-    int np, nc = 0, nkept = 0, i, *coupled;
+    int np, nc = 0, nkept = 0, i;
+    unsigned *coupled;
     const int *pairs;
     if (moved != NULL) {
         nc = nkept = keep_clean_crossings(ec, moved->marked, moved->since);
@@ -246,20 +301,12 @@ int lc_event_crossings_find(lc_world *w, lc_event_crossings *ec, const lc_trial 
     if (nc < 0) return -1;
     /* a body touching nothing and tied by no spring (nor force callback) to another body moves on its
      * own: its time-of-impact evaluations (and swept samples) need only the two bodies */
-    coupled = lc_buf_get(&ec->coupled, (size_t)w->count * sizeof(int));
-    if (coupled == NULL) return -1;
-    memset(coupled, 0, (size_t)w->count * sizeof(int));
-    for (i = 0; i < tr->nrest; ++i) coupled[tr->rest[i].a] = coupled[tr->rest[i].b] = 1;
-    for (i = 0; i < w->spring_count; ++i)
-        if (w->springs[i].def.body_b != LC_WORLD_ANCHOR) {
-            coupled[lc_world_body_index(w, w->springs[i].def.body_a)] = 1;
-            coupled[lc_world_body_index(w, w->springs[i].def.body_b)] = 1;
-        }
-    /* the force callback may tie any body to any other */
-    if (lc_force_callback_on(w))
-        for (i = 0; i < w->count; ++i) coupled[i] = 1;
+    if (new_stamp(&ec->coupled, &ec->coupled_now, &ec->coupled_rows, w->count) == 0) return -1;
+    coupled = (unsigned *)ec->coupled.p;
+    mark_coupled(w, coupled, tr, ec->coupled_now);
     for (i = nkept; i < nc; ++i) ((lc_crossing *)ec->cross.p)[i].t_hi = tr->h;
-    nc = swept_check(w, ec, tr->s0, tr->s1, tr->h, pairs, np, nc, coupled, tr->rows, tr->nrows, tr->rest, tr->nrest);
+    nc = swept_check(w, ec, tr->s0, tr->s1, tr->h, pairs, np, nc, coupled, ec->coupled_now, tr->rows, tr->nrows,
+                     tr->rest, tr->nrest);
     if (nc < 0) return -1;
     *out = (lc_crossing *)ec->cross.p;
     ec->count = nc;

@@ -30,6 +30,7 @@ struct lc_event_regime {
     lc_buf rows, moved, moved_rows;  /* the advanced rows; the bodies the last impact moved */
     lc_buf marks, at_best;           /* the energy check's marks; the best time of impact's state */
     lc_buf clock;                    /* lazy clocks: the time (from the pass's t0) each row's state is at */
+    lc_buf in_rows;                  /* 1 for the advanced rows (spin_max) */
 };
 
 lc_event_regime *lc_event_regime_create(void)
@@ -63,6 +64,7 @@ void lc_event_regime_destroy(lc_event_regime *er)
     lc_buf_free(&er->marks);
     lc_buf_free(&er->at_best);
     lc_buf_free(&er->clock);
+    lc_buf_free(&er->in_rows);
     free(er);
 }
 
@@ -129,6 +131,27 @@ static int sync_near(lazy_clock *lz, const double *s, const double *t, const int
     return 0;
 }
 
+/* The fastest spin |omega| of the advanced rows in s0, which sets the trial interval. Visiting every
+ * row at each pass cost a pass over the world per impact (a sixth of 20 000 free-flying blocks' step).
+ * While the clocks are lazy, s0's spins change only where an impact's rows are copied in (closed form
+ * without torque keeps each spin bit for bit), so the maximum follows those copies; a copy over a row
+ * that may have held it asks for a new visit. The same maximum either way (a max of the same set). */
+typedef struct spin_max {
+    double w;
+    int known;
+    const uint8_t *in_rows;
+} spin_max;
+
+/* Row r of state into s0, keeping m. */
+static void copy_row_spin(double *s0, const double *state, int r, spin_max *m)
+{
+    if (m->known && m->in_rows[r]) {
+        if (fabs(s0[r * 6 + SW]) >= m->w) m->known = 0;
+        else m->w = fmax(m->w, fabs(state[r * 6 + SW]));
+    }
+    memcpy(&s0[r * 6], &state[r * 6], 6 * sizeof(double));
+}
+
 static lc_status event_advance(lc_world *w, lc_event_regime *er, const lc_step_try *step, double dt, double t0,
                                const int *event_rows, int nrows, int *marks_known, int *handover, double *t_handover);
 
@@ -150,7 +173,8 @@ static lc_status event_advance(lc_world *w, lc_event_regime *er, const lc_step_t
     int *drows, ndirty = 0, local_next = 0, body_springs = 0, started_deep = 0, islands_alone = 0;
     int tracked = 0, may_track = 0, lazy = 0, fresh[2] = {-1, -1};
     lazy_clock lz;
-    uint8_t *dirty;
+    spin_max spin;
+    uint8_t *dirty, *in_rows;
     double last_tmin = 0.0, trial_left = 0.0, ts;
     lc_crossing stalled[LC_MAX_STALLED];
     lc_touch *rest = NULL;
@@ -167,6 +191,13 @@ static lc_status event_advance(lc_world *w, lc_event_regime *er, const lc_step_t
     drows = lc_buf_get(&er->moved_rows, (size_t)w->count * sizeof(int));
     if (!dirty || !drows) return lc_fail(w, LC_ERR_NO_MEMORY, "out of memory in step");
     memset(dirty, 0, (size_t)w->count);
+    in_rows = lc_buf_get(&er->in_rows, (size_t)(w->count > 0 ? w->count : 1));
+    if (!in_rows) return lc_fail(w, LC_ERR_NO_MEMORY, "out of memory in step");
+    memset(in_rows, 0, (size_t)w->count);
+    for (i = 0; i < nrows; ++i) in_rows[rows[i]] = 1;
+    spin.w = 0.0;
+    spin.known = 0;
+    spin.in_rows = in_rows;
     lz.w = w;
     lz.s0 = s0;
     lz.clock = lc_buf_get(&er->clock, (size_t)(w->count > 0 ? w->count : 1) * sizeof(double));
@@ -192,9 +223,9 @@ static lc_status event_advance(lc_world *w, lc_event_regime *er, const lc_step_t
         lz.now = dt - remaining;
         if (lazy) {
             /* the impact's rows to s0, and what the resting search below looks at to now */
-            for (i = 0; i < ndirty; ++i) memcpy(&s0[drows[i] * 6], &w->state[drows[i] * 6], 6 * sizeof(double));
+            for (i = 0; i < ndirty; ++i) copy_row_spin(s0, w->state, drows[i], &spin);
             for (i = 0; i < 2; ++i)
-                if (fresh[i] >= 0) memcpy(&s0[fresh[i] * 6], &w->state[fresh[i] * 6], 6 * sizeof(double));
+                if (fresh[i] >= 0) copy_row_spin(s0, w->state, fresh[i], &spin);
             if (sync_near(&lz, w->state, w->state, drows, ndirty, w->def.contact_distance) != 0) goto oom;
         }
         if (local_next && !body_springs)
@@ -229,7 +260,13 @@ static lc_status event_advance(lc_world *w, lc_event_regime *er, const lc_step_t
         if (!lazy) memcpy(s0, w->state, (size_t)w->count * 6 * sizeof(double));
         /* Vertex paths are tested as straight lines in the other body's frame; that holds while bodies
          * turn little, so a fast spinner is checked over shorter trial intervals. */
-        for (i = 0; i < nrows; ++i) wmax = fmax(wmax, fabs(s0[rows[i] * 6 + SW]));
+        if (lazy && spin.known) {
+            wmax = spin.w;
+        } else {
+            for (i = 0; i < nrows; ++i) wmax = fmax(wmax, fabs(s0[rows[i] * 6 + SW]));
+            spin.w = wmax;
+            spin.known = 1;
+        }
         if (wmax * trial > LC_MAX_TRIAL_ROTATION) trial = LC_MAX_TRIAL_ROTATION / wmax;
         /* an absurd spin must not split the step without end: at most LC_MAX_TRIALS rotation-limited
          * intervals (the check is then coarser for that body) */

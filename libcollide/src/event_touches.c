@@ -14,6 +14,7 @@ struct lc_event_touches {
     lc_buf rest;           /* the resting set of the pass in progress */
     lc_buf impact;         /* the touches of an impact */
     lc_buf group;          /* an impact group's queue and marks */
+    int group_rows;        /* the marks are all 0 for a world of this many rows (-1: unknown) */
     lc_buf warm, hash;     /* the last pass's resting touches and forces (warm_count), and their hash table */
     int warm_count;
     /* the touches the last step's projection found at the state it ended in (end_count, -1: none), that
@@ -26,7 +27,10 @@ struct lc_event_touches {
 lc_event_touches *lc_event_touches_create(void)
 {
     lc_event_touches *et = calloc(1, sizeof *et);
-    if (et != NULL) et->end_count = -1;
+    if (et != NULL) {
+        et->end_count = -1;
+        et->group_rows = -1;
+    }
     return et;
 }
 
@@ -263,7 +267,10 @@ int lc_event_impact_group(lc_world *w, lc_event_touches *et, const double *state
     lc_touch *t;
     if (queue == NULL) return -1;
     seen = (uint8_t *)(queue + w->count);
-    memset(seen, 0, (size_t)w->count);
+    /* only the queued bodies are marked, and cleared at the end: zeroing every mark at each impact
+     * was a pass over the world per impact. After a failure, or for another world size, all of them. */
+    if (et->group_rows != w->count) memset(seen, 0, (size_t)w->count);
+    et->group_rows = -1;
     if (!w->is_static[c->a]) { seen[c->a] = 1; queue[nq++] = c->a; }
     if (!w->is_static[c->b]) { seen[c->b] = 1; queue[nq++] = c->b; }
     for (q = 0; q < nq; ++q) {
@@ -301,6 +308,8 @@ int lc_event_impact_group(lc_world *w, lc_event_touches *et, const double *state
         }
         seen[body] = 2;
     }
+    for (q = 0; q < nq; ++q) seen[queue[q]] = 0;
+    et->group_rows = w->count;
     t = (lc_touch *)et->impact.p;
     for (i = 0; i < n && !by_pair; ++i)
         if (t[i].a == c->a && t[i].vertex == c->vertex && t[i].b == c->b) {

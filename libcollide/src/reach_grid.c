@@ -1,8 +1,11 @@
 /* The reach grid (reach_grid.h): cells of one size in a compressed table (each cell's rows together,
  * built by a counting sort); a box wider than a few cells sits in a list that every query scans (walls
- * and floors). A moved row leaves its old entries in the table, marked stale, and is scanned from a
- * list of moved rows until that list grows past a share of the rows, when the table is built anew: a
- * move costs O(1) and a query what lies in its cells plus the moved rows. */
+ * and floors). A moved row leaves its old entries in the table, marked stale, and gets entries in the
+ * cells of its new box in per-cell lists beside the table (a wide new box: a list every query scans),
+ * until those entries outnumber the rows, when the table is built anew: a move costs O(1) amortized
+ * and a query what lies in its cells. (Scanning every moved row at each query instead cost a share of
+ * the world per impact.) An entry left by an earlier move finds a row whose box has gone elsewhere: a
+ * query tests each row's current box, once. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -17,8 +20,11 @@ struct lc_reach_grid {
     lc_buf box;                      /* count x 4: each indexed row's box */
     lc_buf state;                    /* count: 0 not indexed, 1 in the table, 2 wide, 3 moved */
     lc_buf cell_start, cell_rows;    /* the table: rows of cell c at cell_rows[cell_start[c] .. cell_start[c + 1]) */
-    lc_buf wide, moved;              /* rows in the wide list and moved rows (counts below) */
+    lc_buf wide, moved;              /* rows in the wide list and moved rows with a wide box (counts below) */
     int nwide, nmoved, nindexed;
+    lc_buf over_head, over_next, over_row;   /* moved rows' cell lists: cell c's first entry over_head[c]
+                                                (-1: none), each entry's row and next (-1: the last) */
+    int nover;
     lc_buf stamp, found;             /* a query's dedup stamps (count) and its result */
     unsigned stamp_now;
     lc_buf rows_tmp;                 /* the rebuild's row list */
@@ -38,6 +44,9 @@ void lc_reach_grid_destroy(lc_reach_grid *g)
     lc_buf_free(&g->stamp);
     lc_buf_free(&g->found);
     lc_buf_free(&g->rows_tmp);
+    lc_buf_free(&g->over_head);
+    lc_buf_free(&g->over_next);
+    lc_buf_free(&g->over_row);
     free(g);
 }
 
@@ -104,9 +113,13 @@ int lc_reach_grid_build(lc_reach_grid *g, const double *boxes4, const int *rows,
     }
     ncell = g->nx * g->ny;
     start = lc_buf_get(&g->cell_start, (size_t)(ncell + 1) * sizeof(int));
-    if (start == NULL) return -1;
+    {
+        int *head = lc_buf_get(&g->over_head, (size_t)ncell * sizeof(int));
+        if (start == NULL || head == NULL) return -1;
+        for (i = 0; i < ncell; ++i) head[i] = -1;
+    }
     memset(start, 0, (size_t)(ncell + 1) * sizeof(int));
-    g->nwide = g->nmoved = 0;
+    g->nwide = g->nmoved = g->nover = 0;
     for (k = 0; k < n; ++k) {
         int r = rows[k], i0, j0, i1, j1, ii, jj;
         if (is_wide(g, &box[4 * r])) {
@@ -137,21 +150,44 @@ int lc_reach_grid_build(lc_reach_grid *g, const double *boxes4, const int *rows,
     return 0;
 }
 
+/* Entries for row `row` in the cell lists of the cells its box covers (not wide): 0, or -1 without
+ * memory. */
+static int add_cell_entries(lc_reach_grid *g, int row)
+{
+    int i0, j0, i1, j1, ii, jj, need, *head = (int *)g->over_head.p, *next, *rows;
+    cell_range(g, &((const double *)g->box.p)[4 * row], &i0, &j0, &i1, &j1);
+    need = g->nover + (i1 - i0 + 1) * (j1 - j0 + 1);
+    next = lc_buf_get(&g->over_next, (size_t)need * sizeof(int));
+    rows = lc_buf_get(&g->over_row, (size_t)need * sizeof(int));
+    if (next == NULL || rows == NULL) return -1;
+    for (jj = j0; jj <= j1; ++jj)
+        for (ii = i0; ii <= i1; ++ii) {
+            int c = jj * g->nx + ii;
+            rows[g->nover] = row;
+            next[g->nover] = head[c];
+            head[c] = g->nover++;
+        }
+    return 0;
+}
+
 int lc_reach_grid_move(lc_reach_grid *g, int row, const double b[4])
 {
     double *box = (double *)g->box.p;
     uint8_t *state = (uint8_t *)g->state.p;
     memcpy(&box[4 * row], b, 4 * sizeof(double));
-    if (state[row] == 3 || state[row] == 2) return 0;   /* scanned from its list already */
+    if (state[row] == 2) return 0;   /* scanned from the wide list already */
     if (state[row] == 0) g->nindexed++;
     state[row] = 3;
-    {
+    if (is_wide(g, b)) {
         int *moved = lc_buf_get(&g->moved, (size_t)(g->nmoved + 1) * sizeof(int));
         if (moved == NULL) return -1;
         moved[g->nmoved++] = row;
+    } else if (add_cell_entries(g, row) != 0) {
+        return -1;
     }
-    /* past a share of the rows, scanning the moved list costs more than a new table */
-    if (g->nmoved > 32 + g->nindexed / 16) {
+    /* past a share of the rows (wide moved boxes, scanned by every query) or past more entries than
+     * rows, a new table costs less */
+    if (g->nmoved > 32 + g->nindexed / 16 || g->nover > 2 * g->nindexed + 64) {
         int *rows = lc_buf_get(&g->rows_tmp, (size_t)g->count * sizeof(int));
         int i, n = 0;
         if (rows == NULL) return -1;
@@ -209,6 +245,8 @@ int lc_reach_grid_query(lc_reach_grid *g, const double q[4], const int **out)
             int c = jj * g->nx + ii;
             for (k = start[c]; k < start[c + 1]; ++k)
                 if (state[cells[k]] == 1) LC_GRID_TAKE(cells[k]);
+            for (k = ((const int *)g->over_head.p)[c]; k >= 0; k = ((const int *)g->over_next.p)[k])
+                LC_GRID_TAKE(((const int *)g->over_row.p)[k]);
         }
     for (k = 0; k < g->nwide; ++k) LC_GRID_TAKE(((const int *)g->wide.p)[k]);
     for (k = 0; k < g->nmoved; ++k) LC_GRID_TAKE(((const int *)g->moved.p)[k]);

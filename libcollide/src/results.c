@@ -47,6 +47,7 @@ void lc_counters_add(lc_counters *total, const lc_counters *last)
     total->broadphase_pairs += last->broadphase_pairs;
     total->brute_force_steps += last->brute_force_steps;
     total->sort_and_sweep_steps += last->sort_and_sweep_steps;
+    total->grid_steps += last->grid_steps;
     total->collisions += last->collisions;
     total->impulses += last->impulses;
     total->toi_searches += last->toi_searches;

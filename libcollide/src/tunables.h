@@ -25,6 +25,15 @@
  * both 0), the inelastic collapse the contact regime exists for. A settling block makes a handful. */
 #define LC_HANDOVER_EVENTS 8
 
+/* ---- the broad phase (broad_phase.c) ---------------------------------------------------------- */
+
+/* Bodies from which LC_BROADPHASE_AUTO finds the pairs from a grid (box_pairs.c) instead of a sweep
+ * along x: the sweep visits the boxes in an x band, about sqrt(n) of them per box in a square world,
+ * the grid a constant few, after a build of a few passes over the boxes. Instructions per body and
+ * step of the scaling scene (bench/repro/probe_scaling.c, steps 0-30): sweep 4812 / grid 4937 at 2048
+ * bodies, 5815 / 5754 at 4096. */
+#define LC_GRID_MIN_ROWS 4096
+
 /* ---- the event regime (event_regime.c, event_crossings.c, event_projection.c) ------------------ */
 
 /* Most a body may turn (rad) within one collision-checked interval: vertex paths are tested as straight

@@ -173,7 +173,8 @@ static lc_status validate_world_def(lc_world *w, const lc_world_def *d)
     LC_CHECK_IRANGE(w, d->lcp_exact_max, 0, 4096, "lcp_exact_max");
     LC_CHECK_IRANGE(w, d->lcp_max_iterations, 1, 1000000, "lcp_max_iterations");
     LC_CHECK_RANGE(w, d->lcp_tolerance, 0.0, 1.0, "lcp_tolerance");
-    if (d->broadphase != LC_BROADPHASE_AUTO && d->broadphase != LC_BROADPHASE_BRUTE_FORCE && d->broadphase != LC_BROADPHASE_SORT_AND_SWEEP)
+    if (d->broadphase != LC_BROADPHASE_AUTO && d->broadphase != LC_BROADPHASE_BRUTE_FORCE &&
+        d->broadphase != LC_BROADPHASE_SORT_AND_SWEEP && d->broadphase != LC_BROADPHASE_GRID)
         return lc_fail(w, LC_ERR_BAD_ENUM, "broadphase = %d is not an lc_broadphase", (int)d->broadphase);
     LC_CHECK_IRANGE(w, d->broadphase_threshold, 2, 1000000, "broadphase_threshold");
     if (d->regime != LC_REGIME_AUTO && d->regime != LC_REGIME_EVENT && d->regime != LC_REGIME_CONTACT)

@@ -167,6 +167,9 @@ class World:
             seen.add(n)
 
     def _register(self, body_id: int, name: str | None, sync: bool = True) -> "Body":
+        """Records a body's name. sync: the body was just added, so it holds the last state row (C
+        appends rows in insertion order) and its name goes at the end of the row-order list; a full
+        rebuild per body would make adding n bodies cost n^2."""
         if name is None:
             name = f"body{body_id}"
             while name in self._by_name:
@@ -174,7 +177,7 @@ class World:
         self._rec[body_id] = _Record(name)
         self._by_name[name] = body_id
         if sync:
-            self._sync_names()
+            self._names.append(name)
         return Body(self, body_id)
 
     def _sync_names(self) -> None:
@@ -234,9 +237,7 @@ class World:
         self._check_new_names(names)
         ids = ffi.new("lc_body_id[4]")
         check(self._w, lib.lc_world_add_walls(self._w, *args, ids))
-        walls = [self._register(int(ids[i]), names[i], sync=False) for i in range(4)]
-        self._sync_names()
-        return walls
+        return [self._register(int(ids[i]), names[i]) for i in range(4)]
 
     def _id(self, body: BodyRef) -> int:
         if isinstance(body, Body):

@@ -211,7 +211,7 @@ static void world_def_errors(lc_world *w)
         EXPECT(w, lc_world_set_def(w, &d), LC_ERR_BAD_ENUM, "elasticity_rule");
         d = lc_default_world_def(); d.friction_rule = (lc_mix_rule)-1;
         EXPECT(w, lc_world_set_def(w, &d), LC_ERR_BAD_ENUM, "friction_rule");
-        d = lc_default_world_def(); d.broadphase = (lc_broadphase)3;
+        d = lc_default_world_def(); d.broadphase = (lc_broadphase)4;
         EXPECT(w, lc_world_set_def(w, &d), LC_ERR_BAD_ENUM, "broadphase");
         CHECK(lc_world_create(&d, NULL, 0) == NULL, "%s", "lc_world_create(bad def, errbuf NULL) returns NULL");
     }

@@ -1,5 +1,6 @@
-/* test_broad_phase: sort-and-sweep proposes exactly brute force's candidate pairs, in the same order,
- * whatever order it starts from (white box: lc_broad_phase on a world's state arrays).
+/* test_broad_phase: sort-and-sweep and the grid propose exactly brute force's candidate pairs, in the
+ * same order, whatever order the sweep starts from (white box: lc_broad_phase on a world's state
+ * arrays).
  *
  * Sort-and-sweep keeps the last sweep's x order and insertion-sorts from it, and orders the pairs by a
  * radix sort (broad_phase.c). Its output must not depend on that history: 300 boxes of random sizes
@@ -7,11 +8,14 @@
  * between calls - small random moves, a mirror in x (the worst start for an insertion sort), a full
  * shuffle of positions, an interval with a different end state (swept boxes), and boxes stacked in
  * one column (every box overlaps every other in x) - and after each the pair list of sort-and-sweep
- * must equal brute force's entry for entry, with no tolerance: both test the same boxes. So must the
+ * must equal brute force's entry for entry, with no tolerance: both test the same boxes. The grid's
+ * list too (box_pairs.c: the floor is a wide box there, tested against the cells it covers), and also
+ * for boxes no grid cell holds (lc_broad_phase_boxes: a NaN, an infinite, an inverted box). So must the
  * pairs of lc_broad_phase_of (the pairs of a few listed bodies, after an impact) equal brute force's
  * pairs that have a listed body, also while the broad phase tracks an interval in its grid
  * (lc_broad_phase_track): at a state inside the interval, and after a hundred bodies changed paths
- * (lc_broad_phase_retrack, past the share of moved bodies at which the grid is built anew). */
+ * (lc_broad_phase_retrack: their new boxes in the cells' lists beside the table), and after every path
+ * changed three times more (past the entries at which the grid is built anew). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -43,6 +47,44 @@ static void compare(lc_world *w, const double *s0, const double *s1, const char 
     CHECK(nb > 0, "%s: the scene has candidate pairs", what);
     CHECK(nb == ns, "%s: %d pairs by brute force, %d by sort-and-sweep", what, nb, ns);
     if (nb == ns) CHECK(memcmp(brute, sweep, (size_t)nb * 2 * sizeof(int)) == 0, "%s: the same pairs in the same order", what);
+    ns = pairs_of(w, LC_BROADPHASE_GRID, s0, s1, sweep);
+    printf("%-34s %6d pairs (brute force) %6d (grid)\n", what, nb, ns);
+    CHECK(nb == ns, "%s: %d pairs by brute force, %d by the grid", what, nb, ns);
+    if (nb == ns) CHECK(memcmp(brute, sweep, (size_t)nb * 2 * sizeof(int)) == 0, "%s: the grid's pairs in the same order", what);
+}
+
+/* Given boxes (lc_broad_phase_boxes) with a few no grid cell can hold: a NaN box (meets none), an
+ * infinite strip (meets every box in its band), an inverted box (x0 > x1: meets a box that spans it
+ * under the closed-interval test), a point, and two boxes near -1e308 and 1e308 (their distance is no
+ * double); the grid must list brute force's pairs. */
+static void compare_odd_boxes(lc_world *w, const double *s0, int *brute, int *grid)
+{
+    int n = w->count, i, nb, ng;
+    double *b4 = malloc((size_t)n * 4 * sizeof(double));
+    lc_buf buf = {0};
+    CHECK(b4 != NULL, "%s", "allocation");
+    if (b4 == NULL) return;
+    for (i = 0; i < n; i++) lc_swept_box(w, s0, s0, i, 0.0, &b4[4 * i]);
+    b4[4 * 1 + 0] = NAN;
+    b4[4 * 2 + 0] = -INFINITY; b4[4 * 2 + 2] = INFINITY; b4[4 * 2 + 1] = 2.0; b4[4 * 2 + 3] = 2.5;
+    b4[4 * 3 + 0] = 5.0; b4[4 * 3 + 2] = 4.0; b4[4 * 3 + 1] = 0.0; b4[4 * 3 + 3] = 8.0;
+    b4[4 * 4 + 0] = b4[4 * 4 + 2] = 1.0; b4[4 * 4 + 1] = b4[4 * 4 + 3] = 1.0;
+    b4[4 * 5 + 0] = b4[4 * 5 + 2] = -1e308;   /* small and finite, but farther apart than a double spans */
+    b4[4 * 6 + 0] = b4[4 * 6 + 2] = 1e308;
+    w->def.broadphase = LC_BROADPHASE_BRUTE_FORCE;
+    nb = lc_broad_phase_boxes(w, b4, &buf);
+    if (nb > 0) memcpy(brute, buf.p, (size_t)nb * 2 * sizeof(int));
+    w->def.broadphase = LC_BROADPHASE_GRID;
+    ng = lc_broad_phase_boxes(w, b4, &buf);
+    if (ng > 0) memcpy(grid, buf.p, (size_t)ng * 2 * sizeof(int));
+    printf("%-34s %6d pairs (brute force) %6d (grid)\n", "NaN, infinite and inverted boxes", nb, ng);
+    CHECK(nb > 0 && nb == ng, "odd boxes: %d pairs by brute force, %d by the grid", nb, ng);
+    if (nb == ng && nb > 0) CHECK(memcmp(brute, grid, (size_t)nb * 2 * sizeof(int)) == 0, "%s", "odd boxes: the same pairs in the same order");
+    for (i = 0; i < nb; i++)
+        if (brute[2 * i] == 2 || brute[2 * i + 1] == 2) break;
+    CHECK(i < nb, "%s", "the infinite strip meets a box (the case is live)");
+    lc_buf_free(&buf);
+    free(b4);
 }
 
 /* lc_broad_phase_of, which computes the boxes of unlisted bodies only when their centres' bound comes
@@ -139,6 +181,11 @@ int main(void)
             for (k = 1; k <= 100; k++) s2[k * 6 + SY] += sc_uniform(&rng, -3.0, 3.0);
             CHECK(lc_broad_phase_retrack(w, sm, s2, 0.0, dyn, 100, w->def.contact_distance) == 0, "%s", "retrack");
             compare_of(w, sm, s2, "tracked, 100 paths changed", brute, sweep, &rng);
+            for (i = 0; i < 3; i++) {
+                for (k = 1; k < rows; k++) s2[k * 6 + SX] += sc_uniform(&rng, -1.0, 1.0);
+                CHECK(lc_broad_phase_retrack(w, sm, s2, 0.0, dyn, nd, w->def.contact_distance) == 0, "%s", "retrack all");
+                compare_of(w, sm, s2, "tracked, all paths changed", brute, sweep, &rng);
+            }
             lc_broad_phase_untrack(w);
             CHECK(lc_broad_phase_near(w, &s0[0], &near) == -2, "%s", "nothing is tracked after untrack");
         }
@@ -151,6 +198,7 @@ int main(void)
         s0[i * 6 + SY] = 0.8 * i;
     }
     compare(w, s0, s0, "one column", brute, sweep);
+    compare_odd_boxes(w, s0, brute, sweep);
     free(brute);
     free(sweep);
     free(s0);

@@ -9,7 +9,8 @@
  * (3) broadphase AUTO (the *_steps counters count detections, >= 1 per step): 3 bodies -> brute
  *     force in every detection, never sort-and-sweep; 200 bodies -> sort-and-sweep every step,
  *     producing far fewer candidate pairs than the 19900 of brute force; around the default
- *     threshold (32): 31 bodies brute force, 32 sort-and-sweep; forced modes are obeyed.
+ *     threshold (32): 31 bodies brute force, 32 sort-and-sweep; around LC_GRID_MIN_ROWS, sort-and-sweep
+ *     one body below and the grid from it (grid_steps); forced modes are obeyed.
  * (4) stage timing: off by default (every time_* counter exactly 0); on, a scene with impacts and
  *     resting contact spends time in every stage, the six disjoint stages sum to no more than the
  *     whole step (they do not overlap; the remainder is bookkeeping between them), and the contact
@@ -36,6 +37,7 @@
 #include <string.h>
 #include "check.h"
 #include "scenes.h"
+#include "tunables.h"
 
 static void nothing_touches(void)
 {
@@ -170,7 +172,7 @@ static void quiet_rest(void)
 }
 
 /* n bodies of 0.2 m on a grid with 1 m pitch (columns of 10), slow random drift, g = 0. */
-static void broadphase(int n, lc_broadphase mode, int expect_sweep)
+static void broadphase(int n, lc_broadphase mode, lc_broadphase expect)
 {
     lc_world_def d = sc_def_zero_g();
     lc_world *w;
@@ -185,17 +187,17 @@ static void broadphase(int n, lc_broadphase mode, int expect_sweep)
                sc_uniform(&rng, -0.1, 0.1), 0.0, 1.0, 1.0);
     sc_step_n(w, 0.01, 10);
     lc_world_get_counters(w, &last, &tot);
-    printf("broadphase %d bodies mode %d: brute force steps %llu, sort-and-sweep steps %llu, pairs last step %llu\n",
-           n, (int)mode, (unsigned long long)tot.brute_force_steps, (unsigned long long)tot.sort_and_sweep_steps,
+    printf("broadphase %d bodies mode %d: brute force steps %llu, sort-and-sweep steps %llu, grid steps %llu, "
+           "pairs last step %llu\n", n, (int)mode, (unsigned long long)tot.brute_force_steps,
+           (unsigned long long)tot.sort_and_sweep_steps, (unsigned long long)tot.grid_steps,
            (unsigned long long)last.broadphase_pairs);
-    if (expect_sweep) {
-        CHECK(tot.sort_and_sweep_steps >= 10 && tot.brute_force_steps == 0,
-              "%d bodies (mode %d): sort-and-sweep expected, got brute %llu sweep %llu", n, (int)mode,
-              (unsigned long long)tot.brute_force_steps, (unsigned long long)tot.sort_and_sweep_steps);
-    } else {
-        CHECK(tot.brute_force_steps >= 10 && tot.sort_and_sweep_steps == 0,
-              "%d bodies (mode %d): brute force expected, got brute %llu sweep %llu", n, (int)mode,
-              (unsigned long long)tot.brute_force_steps, (unsigned long long)tot.sort_and_sweep_steps);
+    {
+        uint64_t used = expect == LC_BROADPHASE_BRUTE_FORCE ? tot.brute_force_steps
+                      : expect == LC_BROADPHASE_SORT_AND_SWEEP ? tot.sort_and_sweep_steps : tot.grid_steps;
+        CHECK(used >= 10 && tot.brute_force_steps + tot.sort_and_sweep_steps + tot.grid_steps == used,
+              "%d bodies (mode %d): only broadphase %d expected, got brute %llu sweep %llu grid %llu", n, (int)mode,
+              (int)expect, (unsigned long long)tot.brute_force_steps, (unsigned long long)tot.sort_and_sweep_steps,
+              (unsigned long long)tot.grid_steps);
     }
     if (n == 200) {
         /* bodies 0.8 m apart: even pairs overlapping along one axis only (same column: 20 x 45 = 900)
@@ -420,12 +422,15 @@ int main(void)
 {
     nothing_touches();
     resting_is_counted();
-    broadphase(3, LC_BROADPHASE_AUTO, 0);
-    broadphase(200, LC_BROADPHASE_AUTO, 1);
-    broadphase(31, LC_BROADPHASE_AUTO, 0);
-    broadphase(32, LC_BROADPHASE_AUTO, 1);
-    broadphase(3, LC_BROADPHASE_SORT_AND_SWEEP, 1);
-    broadphase(40, LC_BROADPHASE_BRUTE_FORCE, 0);
+    broadphase(3, LC_BROADPHASE_AUTO, LC_BROADPHASE_BRUTE_FORCE);
+    broadphase(200, LC_BROADPHASE_AUTO, LC_BROADPHASE_SORT_AND_SWEEP);
+    broadphase(31, LC_BROADPHASE_AUTO, LC_BROADPHASE_BRUTE_FORCE);
+    broadphase(32, LC_BROADPHASE_AUTO, LC_BROADPHASE_SORT_AND_SWEEP);
+    broadphase(LC_GRID_MIN_ROWS - 1, LC_BROADPHASE_AUTO, LC_BROADPHASE_SORT_AND_SWEEP);
+    broadphase(LC_GRID_MIN_ROWS, LC_BROADPHASE_AUTO, LC_BROADPHASE_GRID);
+    broadphase(3, LC_BROADPHASE_SORT_AND_SWEEP, LC_BROADPHASE_SORT_AND_SWEEP);
+    broadphase(200, LC_BROADPHASE_GRID, LC_BROADPHASE_GRID);
+    broadphase(40, LC_BROADPHASE_BRUTE_FORCE, LC_BROADPHASE_BRUTE_FORCE);
     broadphase_equivalence();
     stage_timing();
     quiet_rest();

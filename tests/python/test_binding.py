@@ -126,6 +126,24 @@ def test_names_follow_rows_when_bodies_are_removed() -> None:
         w.body("b")
 
 
+def test_names_stay_in_row_order_through_adds_walls_removals_and_failed_adds() -> None:
+    # names are appended per add (not rebuilt from the ids): after any mix of calls they must still be
+    # the names of the ids in row order
+    w = three_boxes()
+    w.add_walls(-5.0, -5.0, 15.0, 5.0)
+    w.remove_body("a")
+    w.add_box(1, 1, position=(1.0, 2.0))
+    with pytest.raises(CollideError):
+        w.add_box(1, 1, position=(1.0, 2.0), mass=-1.0)      # refused by C: no name added
+    with pytest.raises(ValueError):
+        w.add_box(1, 1, name="c")                             # refused by Python: a duplicate name
+    w.add_box(1, 1, position=(4.0, 2.0), name="e")
+    by_id = {w.body(n).id: n for n in w.names}
+    assert len(by_id) == len(w) == 8
+    assert w.names == [by_id[int(i)] for i in w.ids]
+    assert w.names[:2] == ["b", "c"] and w.names[-1] == "e" and w.names[2:6] == list(collide.WALL_NAMES)
+
+
 def test_body_properties_and_setters() -> None:
     w = World(gravity=(0, 0))
     b = w.add_box(2.0, 1.0, position=(1.0, 2.0), angle=0.5, velocity=(3.0, 4.0), angular_velocity=0.25,

@@ -60,9 +60,12 @@ typedef enum lc_toi_method {
 
 /* Broadphase pair finding. */
 typedef enum lc_broadphase {
-    LC_BROADPHASE_AUTO = 0,        /* brute force below broadphase_threshold bodies, sort-and-sweep above */
+    LC_BROADPHASE_AUTO = 0,        /* brute force below broadphase_threshold bodies, sort-and-sweep above,
+                                      the grid from 4096 bodies (its search costs the same per body
+                                      at any count; a sweep's grows as sqrt(n) in a square world) */
     LC_BROADPHASE_BRUTE_FORCE = 1,
-    LC_BROADPHASE_SORT_AND_SWEEP = 2
+    LC_BROADPHASE_SORT_AND_SWEEP = 2,
+    LC_BROADPHASE_GRID = 3         /* pairs from a uniform grid of the boxes */
 } lc_broadphase;
 
 /* How two bodies' coefficients combine for a contact. */
@@ -119,7 +122,7 @@ typedef struct lc_world_def {
     int lcp_max_iterations;        /* iterative solver sweeps, [1, 1e6], default 200 */
     double lcp_tolerance;          /* relative residual for the iterative solver, [0, 1], default 1e-10 */
     lc_broadphase broadphase;      /* default LC_BROADPHASE_AUTO */
-    int broadphase_threshold;      /* body count at which AUTO switches to sort-and-sweep, [2, 1e6], default 32 */
+    int broadphase_threshold;      /* body count at which AUTO switches from brute force, [2, 1e6], default 32 */
     lc_regime regime;              /* default LC_REGIME_AUTO */
     int contact_iterations;        /* contact regime: most solver sweeps per solve of 64 points or more (a
                                       smaller one may take proportionally more), [1, 1e6], default 30 */
@@ -253,6 +256,7 @@ typedef struct lc_counters {
     uint64_t broadphase_pairs;        /* candidate pairs the broadphase produced */
     uint64_t brute_force_steps;       /* detections done by brute force */
     uint64_t sort_and_sweep_steps;    /* detections done by sort-and-sweep */
+    uint64_t grid_steps;              /* detections done by the grid */
     uint64_t collisions;              /* impact events (one per time of impact) */
     uint64_t impulses;                /* contact points that received a collision impulse */
     uint64_t toi_searches;            /* time-of-impact searches */
