@@ -15,7 +15,8 @@
  *   4. in small islands, a stick-slip transition or a new contact's arrival inside the step cuts the
  *      step there, and the rest is taken again from step 1;
  *   5. positions: x += h (v_0 + v) / 2 (exact under constant forces);
- *   6. a projection moves overlapping points out by the smallest mass-weighted displacement, and an
+ *   6. a projection moves overlapping points out by the smallest mass-weighted displacement (a large
+ *      pass starting from active sets over a sparse factorization, projection_active_set.c), and an
  *      island without driving forces that still ends with more energy than it began with gives the
  *      excess back from its kinetic energy. An island this cannot keep apart, or whose kinetic energy
  *      cannot pay, is taken again by the event regime (step.c). */
@@ -583,10 +584,10 @@ static int project_by_mprgp(island_ctx *c, const lc_touch *t, int nt, double gp,
 
 /* The start of a projection pass of at least LC_CONTACT_PROJECTION_DIRECT_ROWS points: active sets over
  * a sparse factorization (projection_active_set.h) into the rows' lambda_n, kept when their objective is
- * below no push's (0). Gauss-Seidel and MPRGP need sweeps and products in a pile's
- * height (a settling 1 000-box pile: 50 sweeps and ~1 400 products a step from no push); the
- * factorizations do not, and the sweeps and MPRGP that follow finish from there (about half the
- * instructions of such a step, measured with callgrind). 0, or -1 without memory. */
+ * below no push's (0). Gauss-Seidel and MPRGP need sweeps and products in a pile's height (a settling
+ * 1 000-box pile: 50 sweeps and ~1 400 products a step from no push); the factorizations do not, and the
+ * sweeps and MPRGP that follow finish from the start (with it, such a pile's step takes about half the
+ * instructions, callgrind). 0, or -1 without memory. */
 static int start_projection(island_ctx *c, const lc_touch *t, int nt, double gp, lc_contact_row *rows)
 {
     double *xy = lc_buf_get(&c->cr->b_direct, (size_t)nt * 4 * sizeof(double)), *b, *lambda, value;

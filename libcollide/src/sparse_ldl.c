@@ -67,8 +67,9 @@ static void select_kth(keyed *key, int n, int k)
         if (before(&key[hi], &key[mid])) swap_keyed(&key[hi], &key[mid]);
         pivot = key[mid];
         while (i <= j) {
-            while (before(&key[i], &pivot)) ++i;
-            while (before(&pivot, &key[j])) --j;
+            /* bounded: a NaN coordinate compares neither way, and must not walk a scan off the range */
+            while (i < hi && before(&key[i], &pivot)) ++i;
+            while (j > lo && before(&pivot, &key[j])) --j;
             if (i <= j) {
                 swap_keyed(&key[i], &key[j]);
                 ++i;

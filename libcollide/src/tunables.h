@@ -171,8 +171,8 @@
 #define LC_CONTACT_PROJECTION_LARGE_SLACK 1e-7
 #define LC_CONTACT_LARGE_ISLAND_BODIES 300
 /* m, the overlap a contact-regime step may leave after its projection before the island is taken again
- * in the event regime: the test suites' 1e-9 m, ten times the projection's own aim (in a large island
- * ten times its slack). */
+ * in the event regime: the test suites' 1e-9 m, ten times the projection's own aim; in a large island
+ * scaled with its slack (2.5e-7 m). */
 #define LC_CONTACT_OVERLAP_LEFT 1e-9
 /* The energy gain, relative to an island's energy (the sum of its terms' magnitudes), a contact-regime
  * step may leave when the island's kinetic energy cannot pay for it before the island is taken again
