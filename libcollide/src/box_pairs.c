@@ -10,6 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "box_pairs.h"
+#include "grid_shape.h"
 
 #define LC_BOX_PAIRS_MAX_SPAN 4   /* a box over more cells than this along an axis goes to the wide list */
 #ifndef LC_BOX_PAIRS_CELL
@@ -97,19 +98,11 @@ int lc_box_pairs_find(lc_box_pairs *g, const void *boxes, size_t stride, int n,
         small++;
     }
     if (small == 0) xmin = ymin = xmax = ymax = 0.0;
-    if (!(xmax - xmin < INFINITY && ymax - ymin < INFINITY)) {
+    if (lc_grid_shape(xmin, ymin, xmax, ymax, n, &cell, &nx, &ny) != 0) {
         /* finite boxes farther apart than a double spans: no grid, every box against every box */
         for (k = 0; k < n; ++k) kind[k] = ODD;
-        xmin = ymin = xmax = ymax = 0.0;
-    }
-    for (;;) {
-        double nxd = floor((xmax - xmin) / cell) + 1.0, nyd = floor((ymax - ymin) / cell) + 1.0;
-        if (nxd * nyd <= 4.0 * n + 16.0) {
-            nx = (int)nxd;
-            ny = (int)nyd;
-            break;
-        }
-        cell *= 2.0;
+        xmin = ymin = 0.0;
+        nx = ny = 1;
     }
     span = LC_BOX_PAIRS_MAX_SPAN * cell;
     inv = 1.0 / cell;

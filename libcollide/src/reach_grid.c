@@ -10,6 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "reach_grid.h"
+#include "grid_shape.h"
 
 #define LC_GRID_MAX_SPAN 4   /* a box over more cells than this along an axis goes to the wide list */
 
@@ -99,18 +100,14 @@ int lc_reach_grid_build(lc_reach_grid *g, const double *boxes4, const int *rows,
         small++;
     }
     if (small == 0) xmin = ymin = xmax = ymax = 0.0;
+    if (lc_grid_shape(xmin, ymin, xmax, ymax, n, &g->cell, &g->nx, &g->ny) != 0) {
+        /* finite reaches farther apart than a double spans: one cell holds them all (a query then scans
+         * every row and keeps the ones that overlap it, the same answer) */
+        xmin = ymin = 0.0;
+        g->nx = g->ny = 1;
+    }
     g->x0 = xmin;
     g->y0 = ymin;
-    /* at most about four cells per row: bodies strewn far apart make the cells larger, not the table */
-    for (;;) {
-        double nxd = floor((xmax - xmin) / g->cell) + 1.0, nyd = floor((ymax - ymin) / g->cell) + 1.0;
-        if (nxd * nyd <= 4.0 * n + 16.0) {
-            g->nx = (int)nxd;
-            g->ny = (int)nyd;
-            break;
-        }
-        g->cell *= 2.0;
-    }
     ncell = g->nx * g->ny;
     start = lc_buf_get(&g->cell_start, (size_t)(ncell + 1) * sizeof(int));
     {

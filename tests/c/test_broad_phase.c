@@ -15,7 +15,9 @@
  * pairs that have a listed body, also while the broad phase tracks an interval in its grid
  * (lc_broad_phase_track): at a state inside the interval, and after a hundred bodies changed paths
  * (lc_broad_phase_retrack: their new boxes in the cells' lists beside the table), and after every path
- * changed three times more (past the entries at which the grid is built anew). */
+ * changed three times more (past the entries at which the grid is built anew). The reach grid alone, with
+ * two finite boxes near -1e308 and 1e308 beside two at the origin (bounds wider than a double spans, where
+ * doubling the cell would never end): it is built, and each query finds exactly the boxes it overlaps. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -23,6 +25,7 @@
 
 #include "scenes.h"
 #include "white_box.h"
+#include "reach_grid.h"
 
 #define N_BOXES 300
 
@@ -120,6 +123,22 @@ static void compare_of(lc_world *w, const double *s0, const double *s1, const ch
     free(marked);
 }
 
+static void check_reach_grid_far_apart(void)
+{
+    double boxes[16] = {-1.0, -1.0, 0.5, 0.5, 0.0, 0.0, 1.0, 1.0, -1.5e308, 0.0, -1.4e308, 1.0, 1.4e308, 0.0, 1.5e308, 1.0};
+    double near[4] = {0.2, 0.2, 0.3, 0.3}, far[4] = {1.45e308, 0.5, 1.45e308, 0.5};
+    int rows[4] = {0, 1, 2, 3}, n;
+    const int *found;
+    lc_reach_grid *g = lc_reach_grid_create();
+    CHECK(g != NULL && lc_reach_grid_build(g, boxes, rows, 4, 4) == 0, "%s", "reach grid built over far-apart boxes");
+    if (g == NULL) return;
+    n = lc_reach_grid_query(g, near, &found);
+    CHECK(n == 2 && found[0] == 0 && found[1] == 1, "query at the origin: %d rows (first %d)", n, n > 0 ? found[0] : -1);
+    n = lc_reach_grid_query(g, far, &found);
+    CHECK(n == 1 && found[0] == 3, "query near 1.45e308: %d rows (first %d)", n, n > 0 ? found[0] : -1);
+    lc_reach_grid_destroy(g);
+}
+
 int main(void)
 {
     lc_world_def d = lc_default_world_def();
@@ -129,6 +148,7 @@ int main(void)
     double *s0, *s1;
     size_t max_pairs = (size_t)(N_BOXES + 1) * N_BOXES / 2 + 1;
     if (!w) return CHECK_SUMMARY("test_broad_phase");
+    check_reach_grid_far_apart();
     sc_static_box(w, 60.0, 1.0, 0.0, -0.5, 0.0);   /* row 0 */
     for (i = 0; i < N_BOXES; i++)
         sc_box(w, sc_uniform(&rng, 0.2, 1.5), sc_uniform(&rng, 0.2, 1.5), sc_uniform(&rng, -28, 28),

@@ -58,33 +58,31 @@ def test_restored_node_steps_on_bit_for_bit() -> None:
         b.destroy_node()
 
 
+def restore_is_refused(a: SimNode, match: str) -> list[str]:
+    """Restores a's snapshot into a fresh node, which must refuse it (ValueError matching `match`) and
+    keep its world as it was; returns that node's body names. Destroys both nodes."""
+    b = make_node()
+    before = b.world.save()
+    try:
+        with pytest.raises(ValueError, match=match):
+            msg = a.snapshot_message()
+            b.restore_snapshot(bytes(msg.world), json.loads(msg.node_state))
+        assert b.world.save() == before
+        return list(b.world.names)
+    finally:
+        a.destroy_node()
+        b.destroy_node()
+
+
 def test_snapshot_with_a_ros_spring_is_refused() -> None:
     a = make_node()
     a._on_spring(SpringCommand(name="mouse", body="block1", body_point=Point(), target=Point(x=1.0, y=2.0)))
     assert a._springs
-    b = make_node()
-    before = b.world.save()
-    try:
-        with pytest.raises(ValueError, match="springs made over ROS"):
-            msg = a.snapshot_message()
-            b.restore_snapshot(bytes(msg.world), json.loads(msg.node_state))
-        assert b.world.save() == before
-    finally:
-        a.destroy_node()
-        b.destroy_node()
+    restore_is_refused(a, "springs made over ROS")
 
 
 def test_snapshot_with_a_spawned_body_is_refused() -> None:
     a = make_node()
     req = Spawn.Request(name="extra", width=0.5, height=0.5, pose=Pose(position=Point(x=0.0, y=4.0)))
     assert a._srv_spawn(req, Spawn.Response()).success
-    b = make_node()
-    before = b.world.save()
-    try:
-        with pytest.raises(ValueError, match="spawned"):
-            msg = a.snapshot_message()
-            b.restore_snapshot(bytes(msg.world), json.loads(msg.node_state))
-        assert b.world.save() == before and "extra" not in b.world.names
-    finally:
-        a.destroy_node()
-        b.destroy_node()
+    assert "extra" not in restore_is_refused(a, "spawned")
