@@ -88,7 +88,9 @@ class Stack:
 
     def reset(self) -> None:
         """~/reset; then wait until the client and the page both show the new run: the default scene
-        starts at rest (every velocity exactly 0, so the poses stay put) and the page shows those poses."""
+        starts at rest (every velocity exactly 0, so the poses stay put) and the page shows those poses
+        and has counted the reset's DELETEALL (the poses alone may already match the run before)."""
+        resets = self.js("window.__view.resets || 0")
         assert self.client.call(Empty, "reset") is not None, "sim/reset did not answer"
         got: dict[str, Any] = {}
 
@@ -102,6 +104,7 @@ class Stack:
         self.until(at_rest, "bodies/states of the reset scene")
 
         self.until(lambda: self.page_shows(got), "the page to show the reset scene")
+        self.until(lambda: self.js("window.__view.resets || 0") > resets, "the page to count the reset")
 
     def state(self, name: str) -> tuple[float, ...]:
         s = self.client.body_state(name)
