@@ -265,7 +265,10 @@ lc_contact_solve lc_contact_solver_run(lc_contact_row *rows, int nrows, double *
             r->dir_t = beta * r->dir_t + dt;
             if (beta > 0.0) {
                 double an = beta * (r->dir_n - dn), at = beta * (r->dir_t - dt);
-                /* the momentum beta * p_old, applied to the impulses and the velocities */
+                /* the momentum, applied to the impulses and the velocities: beta times the new
+                 * direction's carried part, beta^2 p_old, a damped form of the method's beta p_old
+                 * (which took more instructions here: 30 boxes settling +17 %, a block pushing a row
+                 * of 40 +84 %, callgrind) */
                 r->lambda_n += an;
                 r->lambda_t += at;
                 if (an != 0.0 || at != 0.0) row_apply(r, an, at, v, inv_mass, inv_inertia);
