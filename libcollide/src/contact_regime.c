@@ -16,7 +16,7 @@
  *      step there, and the rest is taken again from step 1;
  *   5. positions: x += h (v_0 + v) / 2 (exact under constant forces);
  *   6. a projection moves overlapping points out by the smallest mass-weighted displacement (a large
- *      pass starting from active sets over a sparse factorization, projection_active_set.c), and an
+ *      pass starting from active sets over a sparse factorization: contact_projection.c), and an
  *      island without driving forces that still ends with more energy than it began with gives the
  *      excess back from its kinetic energy. An island this cannot keep apart, or whose kinetic energy
  *      cannot pay, is taken again by the event regime (step.c). */
@@ -28,7 +28,8 @@
 #include "contact_active_set.h"
 #include "contact_exact.h"
 #include "contact_solver.h"
-#include "projection_active_set.h"
+#include "contact_island.h"
+#include "contact_projection.h"
 #include "events.h"
 #include "kept_touches.h"
 #include "tunables.h"
@@ -37,24 +38,22 @@
 struct lc_contact_regime {
     lc_contact_cache *cache;
     lc_kept_touches *kept;
-    lc_projection_active_set *direct; /* the projection's start in large islands */
+    lc_contact_projection *projection; /* step 6a */
     lc_buf b_local;      /* int per world row: the row's index in the island being advanced, else -1 */
     int local_rows;      /* rows of b_local that hold -1 outside an island */
     lc_buf b_touch;      /* the sub-step's touches */
     lc_buf b_end;        /* touches at the step's end */
     lc_buf b_rows;       /* solver rows of the flow */
-    lc_buf b_irows;      /* solver rows of the impacts and of the projection */
-    lc_buf b_body;       /* per island body: see body_arrays */
+    lc_buf b_irows;      /* solver rows of the impacts */
+    lc_buf b_body;       /* per island body: see lc_island_bodies */
     lc_buf b_start;      /* island rows' states at the step's start, nb x 6 */
     lc_buf b_acc;        /* world-sized scratch for lc_applied_accelerations */
     lc_buf b_hash;       /* end touch -> flow row */
     lc_buf b_cold, b_cold_load; /* cold_start: the touching points, their loads and rows */
-    lc_buf b_mprgp;      /* project_by_mprgp's vectors */
     lc_buf b_exact;      /* contact_exact.c's and contact_active_set.c's scratch */
     lc_buf b_vstart;     /* start velocities of an exact solve */
     lc_buf b_known;      /* per flow row: 1 if the last step kept a force for its point (even 0) */
     lc_buf b_margin;     /* per island pair: the margin of the last end-of-step search */
-    lc_buf b_direct;     /* start_projection's points and impulses */
 };
 
 lc_contact_regime *lc_contact_regime_create(void)
@@ -63,11 +62,11 @@ lc_contact_regime *lc_contact_regime_create(void)
     if (cr == NULL) return NULL;
     cr->cache = lc_contact_cache_create();
     cr->kept = lc_kept_touches_create();
-    cr->direct = lc_projection_active_set_create();
-    if (cr->cache == NULL || cr->kept == NULL || cr->direct == NULL) {
+    cr->projection = lc_contact_projection_create();
+    if (cr->cache == NULL || cr->kept == NULL || cr->projection == NULL) {
         lc_contact_cache_destroy(cr->cache);
         lc_kept_touches_destroy(cr->kept);
-        lc_projection_active_set_destroy(cr->direct);
+        lc_contact_projection_destroy(cr->projection);
         free(cr);
         return NULL;
     }
@@ -79,8 +78,7 @@ void lc_contact_regime_destroy(lc_contact_regime *cr)
     if (cr == NULL) return;
     lc_contact_cache_destroy(cr->cache);
     lc_kept_touches_destroy(cr->kept);
-    lc_projection_active_set_destroy(cr->direct);
-    lc_buf_free(&cr->b_direct);
+    lc_contact_projection_destroy(cr->projection);
     lc_buf_free(&cr->b_local);
     lc_buf_free(&cr->b_touch);
     lc_buf_free(&cr->b_end);
@@ -92,7 +90,6 @@ void lc_contact_regime_destroy(lc_contact_regime *cr)
     lc_buf_free(&cr->b_hash);
     lc_buf_free(&cr->b_cold);
     lc_buf_free(&cr->b_cold_load);
-    lc_buf_free(&cr->b_mprgp);
     lc_buf_free(&cr->b_exact);
     lc_buf_free(&cr->b_vstart);
     lc_buf_free(&cr->b_known);
@@ -130,30 +127,6 @@ int lc_contact_regime_load(lc_contact_regime *cr, const lc_world *w, struct lc_r
     return lc_kept_touches_load(cr->kept, w, in);
 }
 
-/* The island's bodies as the solver sees them: velocities at the start of the sub-step (v0), the
- * solver's velocities (v), inverse mass and inertia, applied accelerations (acc), projection
- * displacements (disp). */
-typedef struct body_arrays {
-    int n;
-    double *v0, *v, *inv_mass, *inv_inertia, *acc, *disp;
-} body_arrays;
-
-typedef struct island_ctx {
-    lc_world *w;
-    lc_contact_regime *cr;
-    const lc_island *isl;
-    int *local;          /* world row -> island index, -1 outside */
-    body_arrays b;
-    int small;           /* transitions are located (LC_CONTACT_LOCATE_MAX_BODIES) */
-    int precise;         /* solves run to convergence (LC_CONTACT_PRECISE_SWEEPS, _EXACT_POINTS) */
-    double slack;        /* m, the projection's stop and trigger (LC_CONTACT_PROJECTION_SLACK or _LARGE_SLACK) */
-    double start_h;      /* start_margin's h */
-    double dt;           /* the island's step */
-    double residual;
-    double overlap;      /* m, deepest overlap the last advance() left */
-    double unpaid;       /* J, energy gain the last advance() kept (its kinetic energy could not pay) */
-} island_ctx;
-
 static lc_contact_key key_of(const lc_world *w, const lc_touch *t)
 {
     lc_contact_key k;
@@ -164,7 +137,7 @@ static lc_contact_key key_of(const lc_world *w, const lc_touch *t)
     return k;
 }
 
-static int map_island(island_ctx *c)
+static int map_island(lc_contact_island *c)
 {
     lc_world *w = c->w;
     lc_contact_regime *cr = c->cr;
@@ -193,14 +166,14 @@ static int map_island(island_ctx *c)
     return 0;
 }
 
-static void unmap_island(island_ctx *c)
+static void unmap_island(lc_contact_island *c)
 {
     int i;
     for (i = 0; i < c->isl->nrows; ++i) c->local[c->isl->rows[i]] = -1;
 }
 
 /* Applied accelerations of the island's bodies at the current state into b.acc. */
-static int applied(island_ctx *c)
+static int applied(lc_contact_island *c)
 {
     lc_world *w = c->w;
     int nb = c->b.n, i;
@@ -211,74 +184,7 @@ static int applied(island_ctx *c)
     return 0;
 }
 
-/* How far a pair's points can close on each other within h at most: the relative speed of their
- * farthest points and the relative applied acceleration (its term times acc_factor). */
-static double closing_bound(const island_ctx *c, int a, int b, double h, double acc_factor)
-{
-    const lc_world *w = c->w;
-    const double *sa = &w->state[a * 6], *sb = &w->state[b * 6];
-    double dvx = sa[SVX] - sb[SVX], dvy = sa[SVY] - sb[SVY], v, acc = 0.0;
-    int la = c->local[a], lb = c->local[b];
-    v = sqrt(dvx * dvx + dvy * dvy) + fabs(sa[SW]) * w->shape[a].radius + fabs(sb[SW]) * w->shape[b].radius;
-    {
-        double ax = 0.0, ay = 0.0, al = 0.0;
-        if (la >= 0) { ax += c->b.acc[la * 3]; ay += c->b.acc[la * 3 + 1]; al += fabs(c->b.acc[la * 3 + 2]) * w->shape[a].radius; }
-        if (lb >= 0) { ax -= c->b.acc[lb * 3]; ay -= c->b.acc[lb * 3 + 1]; al += fabs(c->b.acc[lb * 3 + 2]) * w->shape[b].radius; }
-        acc = sqrt(ax * ax + ay * ay) + al;
-    }
-    return h * v + 0.5 * h * h * acc * acc_factor;
-}
-
-/* The search margin of a pair at the start of a step of h: contact_distance and what the pair can close
- * in h (speculative points). ctx: the island_ctx, h in its field start_h. */
-static double start_margin(const void *ctx, int a, int b)
-{
-    const island_ctx *c = ctx;
-    return c->w->def.contact_distance + closing_bound(c, a, b, c->start_h, 1.0);
-}
-
-enum { SEARCH_NEAR, SEARCH_STEP, SEARCH_NEXT_STEP };
-
-/* Every contact point of the island's pairs at the current state within contact_distance plus `reach`,
- * and: SEARCH_STEP, within what the pair can close in h (speculative points); SEARCH_NEXT_STEP, within
- * what it can close in a next step of h, with the acceleration term doubled (the accelerations there are
- * those of the end state, which springs may have changed), so the touches can begin that step
- * (kept_touches.h). margin: NULL, or per pair the margin searched. Returns the count or -1. */
-static int collect(island_ctx *c, double h, lc_buf *buf, int mode, double reach, double *margin)
-{
-    lc_world *w = c->w;
-    int k, n = 0;
-    for (k = 0; k < c->isl->npairs; ++k) {
-        int a = c->isl->pairs[2 * k], b = c->isl->pairs[2 * k + 1];
-        double gap = w->def.contact_distance + reach +
-                     (mode == SEARCH_STEP ? closing_bound(c, a, b, h, 1.0)
-                      : mode == SEARCH_NEXT_STEP ? closing_bound(c, a, b, h, 2.0) : 0.0);
-        if (margin != NULL) margin[k] = gap;
-        n = lc_collect_touches_within(w, w->state, a, b, gap, w->def.contact_distance, buf, n);
-        if (n < 0) return -1;
-    }
-    return n;
-}
-
-static void make_row(const island_ctx *c, const lc_touch *t, lc_contact_row *r)
-{
-    const lc_world *w = c->w;
-    lc_vec2 tg = lc_tangent_of(t->n);
-    r->a = w->is_static[t->a] ? -1 : c->local[t->a];
-    r->b = w->is_static[t->b] ? -1 : c->local[t->b];
-    r->nx = t->n.x;
-    r->ny = t->n.y;
-    r->rna = lc_cross(t->ra, t->n);
-    r->rnb = lc_cross(t->rb, t->n);
-    r->rta = lc_cross(t->ra, tg);
-    r->rtb = lc_cross(t->rb, tg);
-    r->mu = t->friction;
-    r->slip = 0;
-    r->target_n = 0.0;
-    r->lambda_n = r->lambda_t = 0.0;
-}
-
-static void count_solve(island_ctx *c, lc_contact_solve s, int rows);
+static void count_solve(lc_contact_island *c, lc_contact_solve s, int rows);
 
 /* Solves rows[0..m) from the velocities in b.v (their start) into b.v: Gauss-Seidel with momentum from
  * the rows' warm start (contact_solver.c), at most contact_iterations sweeps (scaled up for fewer than
@@ -286,7 +192,7 @@ static void count_solve(island_ctx *c, lc_contact_solve s, int rows);
  * precise retry (lc_contact_advance) a problem of at most LC_CONTACT_PRECISE_EXACT_POINTS points is
  * solved exactly (contact_exact.c: active sets, else Lemke) and confirmed by sweeps from that answer, a larger one by up to
  * LC_CONTACT_PRECISE_SWEEPS sweeps. Returns 0, or -1 without memory. */
-static int solve(island_ctx *c, lc_contact_row *rows, int m)
+static int solve(lc_contact_island *c, lc_contact_row *rows, int m)
 {
     lc_world *w = c->w;
     lc_contact_solve s;
@@ -317,7 +223,7 @@ static int solve(island_ctx *c, lc_contact_row *rows, int m)
     return 0;
 }
 
-static void count_solve(island_ctx *c, lc_contact_solve s, int rows)
+static void count_solve(lc_contact_island *c, lc_contact_solve s, int rows)
 {
     c->w->last.contact_sweeps += (uint64_t)s.sweeps;
     c->w->last.contact_points += (uint64_t)rows;
@@ -326,7 +232,7 @@ static void count_solve(island_ctx *c, lc_contact_solve s, int rows)
 
 /* Step 2: impacts at the start of the sub-step. Changes b.v0. Returns the points that received an
  * impulse, or -1. */
-static int impacts(island_ctx *c, lc_touch *t, int nt, double h)
+static int impacts(lc_contact_island *c, lc_touch *t, int nt, double h)
 {
     lc_world *w = c->w;
     /* Any closed point that approaches is an impact: the trapezoidal update would otherwise have to turn
@@ -345,7 +251,7 @@ static int impacts(island_ctx *c, lc_touch *t, int nt, double h)
     for (i = 0; i < nt; ++i) {
         double un, ut;
         int closed = t[i].gap < w->def.contact_distance;
-        make_row(c, &t[i], &rows[m]);
+        lc_contact_island_row(c, &t[i], &rows[m]);
         lc_contact_row_velocity(&rows[m], c->b.v0, &un, &ut);
         /* a large island has no located arrivals: a point that would arrive in the first half of the
          * step would need a bounce to keep its gap under the trapezoidal update, so it is an impact now */
@@ -406,7 +312,7 @@ static int impacts(island_ctx *c, lc_touch *t, int nt, double h)
  * square of the stack's height (a 20-stack sagged and bounced for a second) and a 1000:1 mass ratio never
  * gets there. known[i]: row i's point had a kept force (a kept 0 too: a side contact that carries
  * nothing is not new, and re-spreading the loads every step cost a resting pyramid 3%). */
-static int cold_start(island_ctx *c, const lc_touch *t, int nt, double h, const uint8_t *known, lc_contact_row *rows)
+static int cold_start(lc_contact_island *c, const lc_touch *t, int nt, double h, const uint8_t *known, lc_contact_row *rows)
 {
     lc_world *w = c->w;
     int i, m = 0, cold = 0;
@@ -436,7 +342,7 @@ static int cold_start(island_ctx *c, const lc_touch *t, int nt, double h, const 
 }
 
 /* Step 3: the flow over h from b.v0 into b.v. */
-static int flow(island_ctx *c, const lc_touch *t, int nt, double h, lc_contact_row *rows)
+static int flow(lc_contact_island *c, const lc_touch *t, int nt, double h, lc_contact_row *rows)
 {
     lc_world *w = c->w;
     double gc = w->def.contact_gap;
@@ -449,7 +355,7 @@ static int flow(island_ctx *c, const lc_touch *t, int nt, double h, lc_contact_r
     for (i = 0; i < nt; ++i) {
         lc_contact_row *r = &rows[i];
         double un, ut, fn, ft;
-        make_row(c, &t[i], r);
+        lc_contact_island_row(c, &t[i], r);
         lc_contact_row_velocity(r, c->b.v0, &un, &ut);
         r->target_n = -un - 2.0 * fmax(t[i].gap - gc, 0.0) / h;
         r->slip = ut > slip_speed ? 1 : ut < -slip_speed ? -1 : 0;
@@ -469,7 +375,7 @@ static int flow(island_ctx *c, const lc_touch *t, int nt, double h, lc_contact_r
  * impulse they used, at mu lambda_n per unit of time while slipping, ran out: at sum |lambda_t| /
  * (mu sum lambda_n) of the step (exact for a body sliding to rest on a level surface; elsewhere the
  * next sub-step refines it). */
-static double first_transition(const island_ctx *c, const lc_touch *t, const lc_contact_row *rows, int nt, double h)
+static double first_transition(const lc_contact_island *c, const lc_touch *t, const lc_contact_row *rows, int nt, double h)
 {
     const lc_world *w = c->w;
     double tau = 1.0, gc = w->def.contact_gap, vr = w->def.resting_speed;
@@ -503,7 +409,7 @@ static double first_transition(const island_ctx *c, const lc_touch *t, const lc_
 }
 
 /* Step 5: positions by the trapezoidal rule; velocities become the solver's. */
-static void advance_positions(island_ctx *c, double h)
+static void advance_positions(lc_contact_island *c, double h)
 {
     lc_world *w = c->w;
     int i, k;
@@ -540,7 +446,7 @@ static double island_energy(const lc_world *w, const lc_island *isl, const doubl
 
 /* 1 if a force other than gravity and contacts can do work on the island: thrusters, external force or
  * torque, springs, the force callback (asked after the island's force evaluations, which record it). */
-static int island_driven(const island_ctx *c)
+static int island_driven(const lc_contact_island *c)
 {
     const lc_world *w = c->w;
     int i, k;
@@ -554,127 +460,11 @@ static int island_driven(const island_ctx *c)
     return 0;
 }
 
-/* The projection by MPRGP (sparse_lcp.c, conjugate gradients with bound projections), when Gauss-Seidel
- * did not converge: it needs sweeps in the square of a chain's length (a block pushing a row of twenty
- * boxes left the row overlapping after 400), MPRGP products in its length. left: the deepest overlap the
- * pass starts from. A pass of at least LC_CONTACT_PROJECTION_LARGE points starts from the sweeps' answer
- * (in rows) and stops near the overlap it starts from (tunables.h); a smaller one starts from zero and
- * solves to the island's slack. The displacements land in b.disp. */
-static int project_by_mprgp(island_ctx *c, const lc_touch *t, int nt, double gp, double left, lc_contact_row *rows)
-{
-    lc_world *w = c->w;
-    double *v = lc_buf_get(&c->cr->b_mprgp, (size_t)nt * 4 * sizeof(double)), *b, *lo, *hi, viol, tol;
-    int i, large = nt >= LC_CONTACT_PROJECTION_LARGE;
-    if (v == NULL) return -1;
-    b = v + nt;
-    lo = b + nt;
-    hi = lo + nt;
-    for (i = 0; i < nt; ++i) {
-        v[i] = large ? rows[i].lambda_n : 0.0;
-        b[i] = t[i].gap - gp;
-        lo[i] = 0.0;
-        hi[i] = INFINITY;
-    }
-    tol = large ? fmax(c->slack, LC_CONTACT_PROJECTION_PASS_TOLERANCE * left) : c->slack;
-    if (lc_sparse_lcp(w, t, nt, 0, b, lo, hi, v, tol, LC_CONTACT_PROJECTION_PRODUCTS, &viol) < 0) return -1;
-    for (i = 0; i < nt; ++i)
-        if (v[i] > 0.0 && isfinite(v[i])) lc_contact_row_apply(&rows[i], v[i], 0.0, c->b.disp, c->b.inv_mass, c->b.inv_inertia);
-    return 0;
-}
-
-/* The start of a projection pass of at least LC_CONTACT_PROJECTION_DIRECT_ROWS points: active sets over
- * a sparse factorization (projection_active_set.h) into the rows' lambda_n, kept when their objective is
- * below no push's (0). Gauss-Seidel and MPRGP need sweeps and products in a pile's height (a settling
- * 1 000-box pile: 50 sweeps and ~1 400 products a step from no push); the factorizations do not, and the
- * sweeps and MPRGP that follow finish from the start (with it, such a pile's step takes about half the
- * instructions, callgrind). 0, or -1 without memory. */
-static int start_projection(island_ctx *c, const lc_touch *t, int nt, double gp, lc_contact_row *rows)
-{
-    double *xy = lc_buf_get(&c->cr->b_direct, (size_t)nt * 4 * sizeof(double)), *b, *lambda, value;
-    int i;
-    if (xy == NULL) return -1;
-    b = xy + 2 * nt;
-    lambda = b + nt;
-    for (i = 0; i < nt; ++i) {
-        xy[2 * i] = t[i].p.x;
-        xy[2 * i + 1] = t[i].p.y;
-        b[i] = t[i].gap - gp;
-    }
-    if (lc_projection_active_set_solve(c->cr->direct, rows, xy, nt, c->b.n, c->b.inv_mass, c->b.inv_inertia, b,
-                                       c->slack, lambda, &value) < 0)
-        return -1;
-    if (value < 0.0)
-        for (i = 0; i < nt; ++i) rows[i].lambda_n = lambda[i];
-    return 0;
-}
-
-/* Step 6a: points that end overlapping are moved out, to a gap of LC_CONTACT_PROJECTION_GAP (never more
- * than a thousandth of contact_gap), by the smallest mass-weighted displacement (a complementarity
- * problem in positions, the solver with displacements for velocities). Only out of the overlap, not up
- * to the contact gap: every metre of lift against gravity is energy the step did not have (a
- * contact_gap of 1 mm made that 1e-5 J per body). The touches are searched again after each pass:
- * pushing one pair apart can turn another into the other body. Leaves the touches at the final state
- * in cr->b_end; returns their count, or -1; *left: the deepest overlap left after the last pass (m). */
-static int project(island_ctx *c, double *left)
-{
-    lc_world *w = c->w;
-    double gp = fmin(LC_CONTACT_PROJECTION_GAP, 1e-3 * w->def.contact_gap), reach = 0.0;
-    double *margin = lc_buf_get(&c->cr->b_margin, (size_t)(c->isl->npairs > 0 ? c->isl->npairs : 1) * sizeof(double));
-    int pass, i, k, nt = 0;
-    if (margin == NULL) return -1;
-    for (pass = 0;; ++pass) {
-        lc_touch *t;
-        lc_contact_row *rows;
-        lc_contact_solve ps;
-        int any = 0;
-        /* the points within twice the deepest overlap too: pushing a pair apart by that much can push
-         * a neighbour in (a row of boxes), and a point the solve does not hold is one pass more each */
-        nt = collect(c, c->dt, &c->cr->b_end, SEARCH_NEXT_STEP, reach, margin);
-        if (nt < 0) return -1;
-        t = (lc_touch *)c->cr->b_end.p;
-        *left = 0.0;
-        for (i = 0; i < nt; ++i)
-            if (t[i].gap < -c->slack) {
-                any = 1;
-                *left = fmax(*left, -t[i].gap);
-            }
-        if (reach < 2.0 * *left) {
-            reach = 2.0 * *left;
-            nt = collect(c, c->dt, &c->cr->b_end, SEARCH_NEXT_STEP, reach, margin);
-            if (nt < 0) return -1;
-            t = (lc_touch *)c->cr->b_end.p;
-        }
-        if (!any || pass == LC_CONTACT_PROJECTION_PASSES) break;
-        rows = lc_buf_get(&c->cr->b_irows, (size_t)nt * sizeof(lc_contact_row));
-        if (rows == NULL) return -1;
-        w->last.position_projections++;
-        for (i = 0; i < nt; ++i) {
-            make_row(c, &t[i], &rows[i]);
-            rows[i].mu = 0.0;
-            rows[i].target_n = gp - t[i].gap;
-        }
-        if (nt >= LC_CONTACT_PROJECTION_DIRECT_ROWS && start_projection(c, t, nt, gp, rows) != 0) return -1;
-        memset(c->b.disp, 0, (size_t)c->b.n * 3 * sizeof(double));
-        ps = lc_contact_solver_run(rows, nt, c->b.disp, c->b.inv_mass, c->b.inv_inertia, LC_CONTACT_PROJECTION_SWEEPS,
-                                   c->slack, LC_CONTACT_STALL_SWEEPS);
-        /* a pass that cut the overlap a hundredfold is kept: the next pass starts from there */
-        if (ps.residual > c->slack && ps.residual > LC_CONTACT_PROJECTION_GAIN * *left) {
-            memset(c->b.disp, 0, (size_t)c->b.n * 3 * sizeof(double));
-            if (project_by_mprgp(c, t, nt, gp, *left, rows) != 0) return -1;
-        }
-        for (i = 0; i < c->b.n; ++i) {
-            double *s = &w->state[c->isl->rows[i] * 6];
-            for (k = 0; k < 3; ++k) s[k] += c->b.disp[i * 3 + k];
-        }
-    }
-    return nt;
-}
-
 /* Step 6b: an island no force but gravity and contacts drives ends with at most the energy it began
  * with (the flow and the impacts dissipate; the projection's lift and the rotation's nonlinearity may
  * not); an excess is taken from the kinetic energy by scaling the velocities. Returns the part the
  * kinetic energy could not pay (J, 0 when all was paid). */
-static double energy_guard(island_ctx *c, double e0, double size0)
+static double energy_guard(lc_contact_island *c, double e0, double size0)
 {
     lc_world *w = c->w;
     double ke, size1, e1 = island_energy(w, c->isl, w->state, 1, &ke, &size1), excess, f;
@@ -708,7 +498,7 @@ static uint32_t touch_slot(const lc_touch *t, uint32_t mask)
 
 /* The touches at the end, their forces from the last flow's rows (matched by vertex and edge), reported
  * as resting contacts and kept for the next step's warm start; bodies on a pair with e < 1 are marked. */
-static int finish(island_ctx *c, lc_touch *end, int nend, const lc_touch *t, const lc_contact_row *rows, int nt,
+static int finish(lc_contact_island *c, lc_touch *end, int nend, const lc_touch *t, const lc_contact_row *rows, int nt,
                   double h)
 {
     lc_world *w = c->w;
@@ -750,7 +540,7 @@ static int finish(island_ctx *c, lc_touch *end, int nend, const lc_touch *t, con
 /* Steps 1-6 over dt from the island's current state. Returns 0, -1 without memory or when the force
  * callback failed, or -3 (see lc_contact_advance); on 0 the touches at the end are in cr->b_end (*nend),
  * the last flow's touches and rows in cr->b_touch and cr->b_rows (*nt, *h_last). */
-static int advance(island_ctx *c, double dt, double e0, double size0, int *nend, int *nt, double *h_last)
+static int advance(lc_contact_island *c, double dt, double e0, double size0, int *nend, int *nt, double *h_last)
 {
     lc_world *w = c->w;
     lc_contact_regime *cr = c->cr;
@@ -766,8 +556,8 @@ static int advance(island_ctx *c, double dt, double e0, double size0, int *nend,
         if (applied(c) != 0) return -1;
         /* the step's first search is usually the last step's end search, kept */
         c->start_h = h;
-        *nt = left == dt ? lc_kept_touches_take(cr->kept, w, isl, dt, start_margin, c, &cr->b_touch) : -2;
-        if (*nt == -2) *nt = collect(c, h, &cr->b_touch, SEARCH_STEP, 0.0, NULL);
+        *nt = left == dt ? lc_kept_touches_take(cr->kept, w, isl, dt, lc_contact_island_start_margin, c, &cr->b_touch) : -2;
+        if (*nt == -2) *nt = lc_contact_island_collect(c, h, &cr->b_touch, LC_SEARCH_STEP, 0.0, NULL);
         if (*nt < 0) return -1;
         t = (lc_touch *)cr->b_touch.p;
         rows = lc_buf_get(&cr->b_rows, (size_t)(*nt > 0 ? *nt : 1) * sizeof(lc_contact_row));
@@ -788,7 +578,7 @@ static int advance(island_ctx *c, double dt, double e0, double size0, int *nend,
     }
     *h_last = h;
     /* the touches at the end: projection, results, warm start */
-    *nend = project(c, &overlap);
+    *nend = lc_contact_project(cr->projection, c, &cr->b_end, &cr->b_margin, &overlap);
     if (*nend < 0) return -1;
     /* bodies the projection cannot separate (wedged deep into a corner within one step), or an energy
      * gain the island's kinetic energy cannot pay for */
@@ -802,7 +592,7 @@ static int advance(island_ctx *c, double dt, double e0, double size0, int *nend,
 
 int lc_contact_advance(lc_world *w, lc_contact_regime *cr, const lc_island *isl, double dt)
 {
-    island_ctx c;
+    lc_contact_island c;
     double e0 = 0.0, ke0 = 0.0, size0 = 0.0, h = dt;
     int i, k, nt = 0, nend = 0, status, ncontacts = w->contact_count, nevents = lc_events_staged(w->events);
     double *start;

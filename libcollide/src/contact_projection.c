@@ -1,0 +1,145 @@
+/* The end-of-step position projection of a contact-regime island (contact_projection.h). */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include "contact_projection.h"
+#include "projection_active_set.h"
+#include "tunables.h"
+
+struct lc_contact_projection {
+    lc_projection_active_set *direct; /* the start of large passes */
+    lc_buf b_rows;                    /* a pass's solver rows */
+    lc_buf b_mprgp;                   /* project_by_mprgp's vectors */
+    lc_buf b_direct;                  /* start_projection's points and impulses */
+};
+
+lc_contact_projection *lc_contact_projection_create(void)
+{
+    lc_contact_projection *cp = calloc(1, sizeof *cp);
+    if (cp == NULL) return NULL;
+    cp->direct = lc_projection_active_set_create();
+    if (cp->direct == NULL) {
+        free(cp);
+        return NULL;
+    }
+    return cp;
+}
+
+void lc_contact_projection_destroy(lc_contact_projection *cp)
+{
+    if (cp == NULL) return;
+    lc_projection_active_set_destroy(cp->direct);
+    lc_buf_free(&cp->b_rows);
+    lc_buf_free(&cp->b_mprgp);
+    lc_buf_free(&cp->b_direct);
+    free(cp);
+}
+
+/* The projection by MPRGP (sparse_lcp.c, conjugate gradients with bound projections), when Gauss-Seidel
+ * did not converge: it needs sweeps in the square of a chain's length (a block pushing a row of twenty
+ * boxes left the row overlapping after 400), MPRGP products in its length. left: the deepest overlap the
+ * pass starts from. A pass of at least LC_CONTACT_PROJECTION_LARGE points starts from the sweeps' answer
+ * (in rows) and stops near the overlap it starts from (tunables.h); a smaller one starts from zero and
+ * solves to the island's slack. The displacements land in b.disp. */
+static int project_by_mprgp(lc_contact_projection *cp, lc_contact_island *c, const lc_touch *t, int nt, double gp, double left, lc_contact_row *rows)
+{
+    lc_world *w = c->w;
+    double *v = lc_buf_get(&cp->b_mprgp, (size_t)nt * 4 * sizeof(double)), *b, *lo, *hi, viol, tol;
+    int i, large = nt >= LC_CONTACT_PROJECTION_LARGE;
+    if (v == NULL) return -1;
+    b = v + nt;
+    lo = b + nt;
+    hi = lo + nt;
+    for (i = 0; i < nt; ++i) {
+        v[i] = large ? rows[i].lambda_n : 0.0;
+        b[i] = t[i].gap - gp;
+        lo[i] = 0.0;
+        hi[i] = INFINITY;
+    }
+    tol = large ? fmax(c->slack, LC_CONTACT_PROJECTION_PASS_TOLERANCE * left) : c->slack;
+    if (lc_sparse_lcp(w, t, nt, 0, b, lo, hi, v, tol, LC_CONTACT_PROJECTION_PRODUCTS, &viol) < 0) return -1;
+    for (i = 0; i < nt; ++i)
+        if (v[i] > 0.0 && isfinite(v[i])) lc_contact_row_apply(&rows[i], v[i], 0.0, c->b.disp, c->b.inv_mass, c->b.inv_inertia);
+    return 0;
+}
+
+/* The start of a projection pass of at least LC_CONTACT_PROJECTION_DIRECT_ROWS points: active sets over
+ * a sparse factorization (projection_active_set.h) into the rows' lambda_n, kept when their objective is
+ * below no push's (0). Gauss-Seidel and MPRGP need sweeps and products in a pile's height (a settling
+ * 1 000-box pile: 50 sweeps and ~1 400 products a step from no push); the factorizations do not, and the
+ * sweeps and MPRGP that follow finish from the start (with it, such a pile's step takes about half the
+ * instructions, callgrind). 0, or -1 without memory. */
+static int start_projection(lc_contact_projection *cp, lc_contact_island *c, const lc_touch *t, int nt, double gp, lc_contact_row *rows)
+{
+    double *xy = lc_buf_get(&cp->b_direct, (size_t)nt * 4 * sizeof(double)), *b, *lambda, value;
+    int i;
+    if (xy == NULL) return -1;
+    b = xy + 2 * nt;
+    lambda = b + nt;
+    for (i = 0; i < nt; ++i) {
+        xy[2 * i] = t[i].p.x;
+        xy[2 * i + 1] = t[i].p.y;
+        b[i] = t[i].gap - gp;
+    }
+    if (lc_projection_active_set_solve(cp->direct, rows, xy, nt, c->b.n, c->b.inv_mass, c->b.inv_inertia, b,
+                                       c->slack, lambda, &value) < 0)
+        return -1;
+    if (value < 0.0)
+        for (i = 0; i < nt; ++i) rows[i].lambda_n = lambda[i];
+    return 0;
+}
+
+int lc_contact_project(lc_contact_projection *cp, lc_contact_island *c, lc_buf *end, lc_buf *margins, double *left)
+{
+    lc_world *w = c->w;
+    double gp = fmin(LC_CONTACT_PROJECTION_GAP, 1e-3 * w->def.contact_gap), reach = 0.0;
+    double *margin = lc_buf_get(margins, (size_t)(c->isl->npairs > 0 ? c->isl->npairs : 1) * sizeof(double));
+    int pass, i, k, nt = 0;
+    if (margin == NULL) return -1;
+    for (pass = 0;; ++pass) {
+        lc_touch *t;
+        lc_contact_row *rows;
+        lc_contact_solve ps;
+        int any = 0;
+        /* the points within twice the deepest overlap too: pushing a pair apart by that much can push
+         * a neighbour in (a row of boxes), and a point the solve does not hold is one pass more each */
+        nt = lc_contact_island_collect(c, c->dt, end, LC_SEARCH_NEXT_STEP, reach, margin);
+        if (nt < 0) return -1;
+        t = (lc_touch *)end->p;
+        *left = 0.0;
+        for (i = 0; i < nt; ++i)
+            if (t[i].gap < -c->slack) {
+                any = 1;
+                *left = fmax(*left, -t[i].gap);
+            }
+        if (reach < 2.0 * *left) {
+            reach = 2.0 * *left;
+            nt = lc_contact_island_collect(c, c->dt, end, LC_SEARCH_NEXT_STEP, reach, margin);
+            if (nt < 0) return -1;
+            t = (lc_touch *)end->p;
+        }
+        if (!any || pass == LC_CONTACT_PROJECTION_PASSES) break;
+        rows = lc_buf_get(&cp->b_rows, (size_t)nt * sizeof(lc_contact_row));
+        if (rows == NULL) return -1;
+        w->last.position_projections++;
+        for (i = 0; i < nt; ++i) {
+            lc_contact_island_row(c, &t[i], &rows[i]);
+            rows[i].mu = 0.0;
+            rows[i].target_n = gp - t[i].gap;
+        }
+        if (nt >= LC_CONTACT_PROJECTION_DIRECT_ROWS && start_projection(cp, c, t, nt, gp, rows) != 0) return -1;
+        memset(c->b.disp, 0, (size_t)c->b.n * 3 * sizeof(double));
+        ps = lc_contact_solver_run(rows, nt, c->b.disp, c->b.inv_mass, c->b.inv_inertia, LC_CONTACT_PROJECTION_SWEEPS,
+                                   c->slack, LC_CONTACT_STALL_SWEEPS);
+        /* a pass that cut the overlap a hundredfold is kept: the next pass starts from there */
+        if (ps.residual > c->slack && ps.residual > LC_CONTACT_PROJECTION_GAIN * *left) {
+            memset(c->b.disp, 0, (size_t)c->b.n * 3 * sizeof(double));
+            if (project_by_mprgp(cp, c, t, nt, gp, *left, rows) != 0) return -1;
+        }
+        for (i = 0; i < c->b.n; ++i) {
+            double *s = &w->state[c->isl->rows[i] * 6];
+            for (k = 0; k < 3; ++k) s[k] += c->b.disp[i * 3 + k];
+        }
+    }
+    return nt;
+}
