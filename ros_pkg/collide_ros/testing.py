@@ -178,6 +178,16 @@ class SimClient:
             self.ex.spin_once(timeout_sec=0.02)
         return bool(pred())
 
+    def since(self, key: str, mark: int) -> list[Any]:
+        """The messages on ``key`` received after ``self.count[key]`` was ``mark``, oldest first. The
+        history holds the newest 2000 only: slicing it by a count taken earlier goes wrong (empty) once
+        more than that arrived in all, so the new ones are counted from its end."""
+        new = self.count[key] - mark
+        if new <= 0:
+            return []
+        held = list(self.history[key])
+        return [m for _, m in held[-new:]]
+
     def fresh(self, key: str, n: int = 1, timeout: float = 10.0) -> Any:
         """Wait for n new messages on ``key`` and return the last one (None on timeout)."""
         start = self.count[key]

@@ -237,14 +237,14 @@ def test_reset_restores_scene_and_clock_runs_on(sim: SimClient) -> None:
     sim_wait(sim, 0.3)
     assert sim.body_state("block1")[0] > -2.5 + 1e-3
     t_before = sim.sim_time()
-    n_markers = len(sim.history["markers"])
+    n_markers = sim.count["markers"]
     assert sim.call(Empty, "reset") is not None
     assert sim.wait_for(lambda: at_start(sim), 20.0)
     s = sim.body_state("block1")
     # markers: one message, DELETEALL first, then the new scene (so no subscriber gets one without the other)
     def reset_markers() -> Any:
-        return next((arr for _, arr in list(sim.history["markers"])[n_markers:]
-                     if any(m.action == 3 for m in arr.markers)), None)
+        return next((arr for arr in sim.since("markers", n_markers) if any(m.action == 3 for m in arr.markers)),
+                    None)
     assert sim.wait_for(reset_markers, 10.0)
     arr = reset_markers().markers
     assert arr[0].action == 3 and all(m.action != 3 for m in arr[1:])
@@ -425,7 +425,7 @@ def test_contacts_report_the_wall_impact(sim: SimClient) -> None:
     sim.publish("block2/thrust", wrench(10.0))
     # 10 N for the 0.5 s timeout: 5 m/s after 1.25 m; the 3 m gap to the right wall closes by t ~ 0.85 s
     sim_wait(sim, 1.2)
-    impulses = [c.impulse for _, msg in list(sim.history["contacts"])[n0:] for c in msg.contacts
+    impulses = [c.impulse for msg in sim.since("contacts", n0) for c in msg.contacts
                 if {c.body_a, c.body_b} == {"block2", "wall_right"} and c.kind == c.COLLISION]
     assert impulses, "no block2/wall_right collision reported"
     # head-on at e = 1 against an immovable wall: total impulse 2 m v = 2 * 1 kg * 5 m/s, and the block

@@ -64,10 +64,10 @@ def test_one_clock_that_never_jumps_back(robots: tuple[SimClient, SimClient]) ->
 def _tf_frames(client: SimClient, want: int, timeout: float = 20.0) -> dict[str, str]:
     """child -> parent frame of every transform seen on /tf until ``want`` children are known."""
     seen: dict[str, str] = {}
-    start = len(client.history["tf"])
+    start = client.count["tf"]
 
     def enough() -> bool:
-        for _, msg in list(client.history["tf"])[start:]:
+        for msg in client.since("tf", start):
             for t in msg.transforms:
                 seen[t.child_frame_id] = t.header.frame_id
         return len(seen) >= want

@@ -191,7 +191,7 @@ def test_drag_pulls_body_toward_pointer(stack: Stack) -> None:
     try:
         stack.until(received, "spring messages from the page")
         # the press grabs block1 at its centre; the moves follow the pointer to (tx, ty)
-        first = [m for _, m in stack.client.history["spring"]][-(stack.client.count["spring"] - before):][0]
+        first = stack.client.since("spring", before)[0]
         assert first.body == "block1" and not first.release and first.name.startswith("view")
         assert abs(first.body_point.x) < 0.05 and abs(first.body_point.y) < 0.05
         stack.until(lambda: abs(stack.client.last["spring"].target.y - ty) < 0.05
@@ -218,8 +218,7 @@ def test_holding_keys_fires_thrusters(stack: Stack) -> None:
             stack.until(lambda: stack.state(body)[3] < v0 - 0.05, f"{key} to push {body}")
 
             def since() -> list[tuple[str, list[bool]]]:
-                n = stack.client.count["thrusters"] - n0
-                return [(m.body, list(m.firing)) for _, m in list(stack.client.history["thrusters"])[-n:]] if n else []
+                return [(m.body, list(m.firing)) for m in stack.client.since("thrusters", n0)]
             stack.until(since, f"the view's ThrusterCommand for {body}")
             assert all(s == (body, [True, False, False, False]) for s in since()), since()
         finally:
