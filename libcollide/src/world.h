@@ -257,9 +257,15 @@ int lc_collect_touches(const lc_world *w, const double *state, int a, int b, dou
  * passing just beyond the end of an edge (over a seam between two slabs) for one that will hit it. */
 int lc_collect_touches_within(const lc_world *w, const double *state, int a, int b, double max_gap, double extent,
                               lc_buf *buf, int count);
-/* Crossing found between two states: vertex of row a entered edge of row b. */
-/* t_hi: a time (from the interval's start) by which the vertex is known to be inside. */
-typedef struct lc_crossing { int a, b, vertex, edge; double toi, t_hi; } lc_crossing;
+/* Crossing found between two states: vertex of row a entered edge of row b. Its time of impact lies
+ * in [t_lo, t_hi] from the interval's start: outside at t_lo, known to be inside by t_hi. Once
+ * searched: toi, that time (< 0: none found), clear_to, a time before which it has none, and by_pair,
+ * 1 when toi is the pair's first touch by its separation rather than the vertex's. */
+typedef struct lc_crossing {
+    int a, b, vertex, edge;
+    double t_lo, t_hi, toi, clear_to;
+    int by_pair;
+} lc_crossing;
 /* Appends crossings of the pair (a, b) between state0 and state1. Returns new count or -1. */
 int lc_find_crossings(const lc_world *w, const double *s0, const double *s1, int a, int b,
                       lc_buf *buf, int count);
