@@ -204,9 +204,18 @@ static int order_pairs(lc_world *w, int *p, int count)
 }
 
 /* Body i's box over the interval (both end poses), grown by margin. */
+static void bound_box(const lc_world *w, const double *s0, const double *s1, int i, double margin, box *out);
+
 static void swept_box(lc_world *w, const double *s0, const double *s1, int i, double margin, box *out)
 {
     box b0, b1;
+    if (s1 != s0 && !w->is_static[i] && fabs(s1[i * 6 + SA] - s0[i * 6 + SA]) > LC_MAX_TRIAL_ROTATION) {
+        /* turning farther than a rotation-limited interval allows (a free-flight step checks a fast
+         * spinner's pairs in parts): its corners swing well outside the end poses' boxes between them,
+         * and every pose lies within its bounding radius of the centre */
+        bound_box(w, s0, s1, i, margin, out);
+        return;
+    }
     body_box(w, s0, i, &b0);
     if (s1 != s0 && !w->is_static[i]) {
         body_box(w, s1, i, &b1);

@@ -158,7 +158,6 @@ static int keep_clean_crossings(lc_event_crossings *ec, const uint8_t *dirty, do
         if (dirty[c[i].a] || dirty[c[i].b]) continue;
         c[i].t_hi -= tmin;
         c[i].t_lo = fmax(c[i].t_lo - tmin, 0.0);
-        if (c[i].toi >= 0.0) c[i].toi = fmax(c[i].toi - tmin, 0.0);
         c[i].clear_to = fmax(c[i].clear_to - tmin, 0.0);
         if (!(c[i].t_hi > 0.0)) continue;
         c[kept++] = c[i];

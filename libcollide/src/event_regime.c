@@ -30,7 +30,8 @@ struct lc_event_regime {
     lc_buf rows, moved, moved_rows;  /* the advanced rows; the bodies the last impact moved */
     lc_buf marks, at_best;           /* the energy check's marks; the best time of impact's state */
     lc_buf at_lo;                    /* a crossing's rows at the start of its bracket */
-    lc_buf clock;                    /* lazy clocks: the time (from the pass's t0) each row's state is at */
+    lc_buf clock;                    /* lazy clocks: the time (from the pass's t0) each row's state is at, and its anchor's */
+    lc_buf anchor;                   /* lazy clocks: each row's state at its last event */
     lc_buf in_rows;                  /* 1 for the advanced rows (spin_max) */
 };
 
@@ -66,6 +67,7 @@ void lc_event_regime_destroy(lc_event_regime *er)
     lc_buf_free(&er->at_best);
     lc_buf_free(&er->at_lo);
     lc_buf_free(&er->clock);
+    lc_buf_free(&er->anchor);
     lc_buf_free(&er->in_rows);
     free(er);
 }
@@ -86,23 +88,39 @@ static int rows_closed_form(const lc_world *w, const int *rows, int nrows)
 
 /* Lazy clocks (free flight while the broad phase tracks the trial): an impact advances only the bodies
  * it involves and the ones it looks at to its time; every other body stays where its last event left
- * it, at clock[row], until something near it looks at it or the trial ends. w->state and s0 hold each
- * row at its clock (the impact's rows are copied from w->state to s0 at the next pass's start). */
+ * it until something near it looks at it or the trial ends. w->state and s0 hold each row at
+ * clock[row] (the impact's rows are copied from w->state to s0 at the next pass's start). A row is
+ * brought to a time in one closed-form advance from its anchor, the state its last event (an impact,
+ * or the trial's start) left it in at anchor_t[row]: so its state at any time is the same bits however
+ * often, and after whichever other bodies' events, it was looked at. */
 typedef struct lazy_clock {
     lc_world *w;
-    double *s0, *clock;
+    double *s0, *clock, *anchor, *anchor_t;
     double now;   /* the time the rows looked at are brought to */
 } lazy_clock;
+
+/* Row r of w->state at time t, from its anchor. */
+static int row_at(lazy_clock *lz, int r, double t)
+{
+    return lc_integrate_rows(lz->w, lz->anchor, t - lz->anchor_t[r], &r, 1, NULL, 0, lz->w->state);
+}
+
+/* The rows' states in w->state are their new anchors, at time t. */
+static void anchor_rows(lazy_clock *lz, const int *rows, int n, double t)
+{
+    int i;
+    for (i = 0; i < n; ++i) {
+        memcpy(&lz->anchor[rows[i] * 6], &lz->w->state[rows[i] * 6], 6 * sizeof(double));
+        lz->anchor_t[rows[i]] = t;
+    }
+}
 
 static int sync_row(void *ctx, int r)
 {
     lazy_clock *lz = ctx;
     lc_world *w = lz->w;
-    double h;
     if (w->is_static[r] || lz->clock[r] == lz->now) return 0;
-    h = lz->now - lz->clock[r];
-    /* closed form in place: each row's positions are written from its velocities before those */
-    if (lc_integrate_rows(w, w->state, h, &r, 1, NULL, 0, w->state) != 0) return -1;
+    if (row_at(lz, r, lz->now) != 0) return -1;
     memcpy(&lz->s0[r * 6], &w->state[r * 6], 6 * sizeof(double));
     lz->clock[r] = lz->now;
     return 0;
@@ -226,7 +244,7 @@ static lc_status event_advance(lc_world *w, lc_event_regime *er, const lc_step_t
                                const int *event_rows, int nrows, int *marks_known, int *handover, double *t_handover)
 {
     size_t bytes;
-    double *s0, *s1, *scratch, *at_lo, remaining;
+    double *s0, *s1, *scratch, *at_lo, remaining, now_t = 0.0;
     int *rows, i, events = 0, nstalled = 0, nrest = 0, passes = 0, persisting = -1, last_impact_body = -1;
     int dissipative_events = 0;
     int *drows, ndirty = 0, local_next = 0, body_springs = 0, started_deep = 0, islands_alone = 0;
@@ -260,9 +278,11 @@ static lc_status event_advance(lc_world *w, lc_event_regime *er, const lc_step_t
     spin.in_rows = in_rows;
     lz.w = w;
     lz.s0 = s0;
-    lz.clock = lc_buf_get(&er->clock, (size_t)(w->count > 0 ? w->count : 1) * sizeof(double));
+    lz.clock = lc_buf_get(&er->clock, (size_t)(w->count > 0 ? w->count : 1) * 2 * sizeof(double));
+    lz.anchor = lc_buf_get(&er->anchor, bytes);
     lz.now = 0.0;
-    if (lz.clock == NULL) return lc_fail(w, LC_ERR_NO_MEMORY, "out of memory in step");
+    if (lz.clock == NULL || lz.anchor == NULL) return lc_fail(w, LC_ERR_NO_MEMORY, "out of memory in step");
+    lz.anchor_t = lz.clock + (w->count > 0 ? w->count : 1);
     for (i = 0; i < w->spring_count; ++i)
         if (w->springs[i].def.body_b != LC_WORLD_ANCHOR) body_springs = 1;
     /* the force callback may tie any body to any other, as a spring between bodies does */
@@ -270,8 +290,8 @@ static lc_status event_advance(lc_world *w, lc_event_regime *er, const lc_step_t
 
     remaining = dt;
     while (remaining > 0.0) {
-        int nc, best = -1, nimp, hits, by_pair = 0, adv[2], adv_n = 0;
-        double tmin = remaining;
+        int nc, best = -1, nimp, hits, by_pair = 0, adv[2], adv_n = 0, at_t_best;
+        double tmin = remaining, t_best = 0.0;
         lc_crossing *cross;
         lc_touch *impact;
 
@@ -280,10 +300,12 @@ static lc_status event_advance(lc_world *w, lc_event_regime *er, const lc_step_t
         /* after an impact in free flight only the impact's bodies can have come to touch anything:
          * every other pair was apart (nothing rested) and moved without an impact */
         ts = lc_stage_begin(w);
-        lz.now = dt - remaining;
+        lz.now = now_t;
         if (lazy) {
-            /* the impact's rows to s0, and what the resting search below looks at to now */
+            /* the impact's rows to s0 and to their anchors, and what the resting search below looks at
+             * to now */
             for (i = 0; i < ndirty; ++i) copy_row_spin(s0, w->state, drows[i], &spin);
+            anchor_rows(&lz, drows, ndirty, lz.now);
             for (i = 0; i < 2; ++i)
                 if (fresh[i] >= 0) copy_row_spin(s0, w->state, fresh[i], &spin);
             if (sync_near(&lz, w->state, w->state, drows, ndirty, w->def.contact_distance) != 0) goto oom;
@@ -462,10 +484,11 @@ static lc_status event_advance(lc_world *w, lc_event_regime *er, const lc_step_t
                             if (tau < -1.5) goto oom;
                         }
                         if (tau < 0.0) cross[i].clear_to = cross[i].t_hi;
-                        else cross[i].toi = tau;
+                        else cross[i].toi = lz.now + tau;
                     }
-                    if (cross[i].toi >= 0.0 && (best < 0 || cross[i].toi < tmin)) {
-                        tmin = cross[i].toi;
+                    if (cross[i].toi >= 0.0 && (best < 0 || cross[i].toi < t_best)) {
+                        t_best = cross[i].toi;
+                        tmin = fmax(t_best - lz.now, 0.0);
                         best = i;
                     }
                     continue;
@@ -503,6 +526,7 @@ static lc_status event_advance(lc_world *w, lc_event_regime *er, const lc_step_t
             memcpy(w->state, s1, (size_t)w->count * 6 * sizeof(double));
             remaining -= trial;
             if (remaining < 1e-14 * dt) remaining = 0.0;
+            now_t = dt - remaining;
             w->time = t0 + (dt - remaining);
             continue;
         }
@@ -514,7 +538,8 @@ static lc_status event_advance(lc_world *w, lc_event_regime *er, const lc_step_t
             if (lc_broad_phase_track(w, s0, s1, trial, rows, nrows, w->def.contact_distance) != 0) goto oom;
             tracked = 1;
             lazy = 1;
-            for (i = 0; i < nrows; ++i) lz.clock[rows[i]] = lz.now;
+            memcpy(lz.anchor, s0, (size_t)w->count * 6 * sizeof(double));
+            for (i = 0; i < nrows; ++i) lz.clock[rows[i]] = lz.anchor_t[rows[i]] = lz.now;
         }
         ts = lc_stage_begin(w);
         /* lazy clocks: only the crossing's two bodies go to the impact's time here (the others it acts
@@ -525,10 +550,17 @@ static lc_status event_advance(lc_world *w, lc_event_regime *er, const lc_step_t
             if (!w->is_static[cross[best].b]) adv[adv_n++] = cross[best].b;
         }
         by_pair = cross[best].by_pair;
+        at_t_best = 0;
         if (tmin > 0.0) {
             int ba = cross[best].a, bb = cross[best].b;
-            if (lc_integrate_rows(w, s0, tmin, lazy ? adv : rows, lazy ? adv_n : nrows, rest, nrest, w->state) != 0)
+            if (lazy && free_flight && t_best >= 0.0) {
+                /* from their anchors, as every lazy row (below) */
+                for (i = 0; i < adv_n; ++i)
+                    if (row_at(&lz, adv[i], t_best) != 0) goto oom;
+                at_t_best = 1;
+            } else if (lc_integrate_rows(w, s0, tmin, lazy ? adv : rows, lazy ? adv_n : nrows, rest, nrest, w->state) != 0) {
                 goto oom;
+            }
             /* another vertex of the pair (corner against corner) already inside, deeper than any
              * crossing test can see from here on: the pair met earlier, find when */
             if (lc_pair_separation(w, w->state, ba, bb) < -0.5 * w->def.contact_gap &&
@@ -545,6 +577,8 @@ static lc_status event_advance(lc_world *w, lc_event_regime *er, const lc_step_t
                 ts = lc_stage_begin(w);
                 if (t2 < 0.0) goto oom;
                 tmin = t2;
+                t_best = -1.0;   /* the time from this pass's start */
+                at_t_best = 0;
                 by_pair = 1;
                 if (lc_integrate_rows(w, s0, tmin, lazy ? adv : rows, lazy ? adv_n : nrows, rest, nrest, w->state) != 0)
                     goto oom;
@@ -553,12 +587,24 @@ static lc_status event_advance(lc_world *w, lc_event_regime *er, const lc_step_t
             memcpy(w->state, s0, (size_t)w->count * 6 * sizeof(double));
         }
         lc_stage_end(w, &w->last.time_integration, ts);
-        remaining -= tmin;
-        w->time = t0 + (dt - remaining);
+        /* in free flight the impact's time is its crossing's, kept from the step's start: the same bits
+         * whichever other impacts came between (not a sum of their intervals) */
+        if (free_flight && t_best >= 0.0) {
+            remaining = dt - t_best;
+            w->time = t0 + t_best;
+        } else {
+            remaining -= tmin;
+            w->time = t0 + (dt - remaining);
+        }
         if (remaining < 1e-14 * dt) remaining = 0.0;
+        now_t = free_flight && t_best >= 0.0 && remaining > 0.0 ? t_best : dt - remaining;
 
-        lz.now = dt - remaining;
-        for (i = 0; i < adv_n; ++i) lz.clock[adv[i]] = lz.now;
+        lz.now = now_t;
+        for (i = 0; i < adv_n; ++i) {
+            /* the crossing's two bodies at the impact's time from their anchors, unless they are */
+            if (!(at_t_best && now_t == t_best) && lz.clock[adv[i]] != now_t && row_at(&lz, adv[i], now_t) != 0) goto oom;
+            lz.clock[adv[i]] = now_t;
+        }
         fresh[0] = adv_n > 0 ? adv[0] : -1;
         fresh[1] = adv_n > 1 ? adv[1] : -1;
         ts = lc_stage_begin(w);
@@ -598,7 +644,8 @@ static lc_status event_advance(lc_world *w, lc_event_regime *er, const lc_step_t
                     if (!w->is_static[ab[q]] && !dirty[ab[q]]) { dirty[ab[q]] = 1; drows[ndirty++] = ab[q]; }
             }
             local_next = nrest == 0;
-            trial_left = trial - tmin;
+            /* free flight: the trial ends with the step */
+            trial_left = free_flight ? remaining : trial - tmin;
             last_tmin = tmin;
         }
         if (hits == 0 && tmin == 0.0) {

@@ -259,8 +259,9 @@ int lc_collect_touches_within(const lc_world *w, const double *state, int a, int
                               lc_buf *buf, int count);
 /* Crossing found between two states: vertex of row a entered edge of row b. Its time of impact lies
  * in [t_lo, t_hi] from the interval's start: outside at t_lo, known to be inside by t_hi. Once
- * searched: toi, that time (< 0: none found), clear_to, a time before which it has none, and by_pair,
- * 1 when toi is the pair's first touch by its separation rather than the vertex's. */
+ * searched: toi, that time from the start of the event regime's step (< 0: none found), clear_to, a
+ * time from the interval's start before which it has none, and by_pair, 1 when toi is the pair's first
+ * touch by its separation rather than the vertex's. */
 typedef struct lc_crossing {
     int a, b, vertex, edge;
     double t_lo, t_hi, toi, clear_to;
