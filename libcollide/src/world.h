@@ -288,8 +288,11 @@ int lc_broad_phase(lc_world *w, const double *s0, const double *s1, double margi
  * bound of their distance that, unlike the bounding circles, stays tight for a block over a long
  * floor or beside a wall (boxes from the per-body cache). */
 double lc_bounds_gap(const lc_world *w, const double *state, int a, int b);
-/* Body row's box over the interval (both end poses) grown by margin: x0, y0, x1, y1. */
+/* Body row's box over the interval grown by margin (x0, y0, x1, y1), as the pair searches take it: its
+ * end poses' boxes, or its bounding circle's where it turns more than LC_MAX_TRIAL_ROTATION. */
 void lc_swept_box(lc_world *w, const double *s0, const double *s1, int row, double margin, double out[4]);
+/* Body row's end poses' boxes, joined and grown by margin (the caller allows for the turn between). */
+void lc_end_poses_box(lc_world *w, const double *s0, const double *s1, int row, double margin, double out[4]);
 /* Candidate pairs, as lc_broad_phase, of given boxes (4 doubles per row: x0, y0, x1, y1). */
 int lc_broad_phase_boxes(lc_world *w, const double *boxes4, lc_buf *buf);
 /* The same, restricted to pairs with at least one of the nlist bodies in list (marked[row] != 0). */
