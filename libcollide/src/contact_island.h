@@ -25,6 +25,7 @@ typedef struct lc_contact_island {
     lc_island_bodies b;
     int small;           /* transitions are located (LC_CONTACT_LOCATE_MAX_BODIES) */
     int precise;         /* solves run to convergence (LC_CONTACT_PRECISE_SWEEPS, _EXACT_POINTS) */
+    double max_h;        /* s, the longest sub-step (0: the whole step, cut only at transitions) */
     double slack;        /* m, the projection's stop and trigger (LC_CONTACT_PROJECTION_SLACK or _LARGE_SLACK) */
     double start_h;      /* lc_contact_island_start_margin's h */
     double dt;           /* the island's step */

@@ -553,6 +553,7 @@ static int advance(lc_contact_island *c, double dt, double e0, double size0, int
     while (left > 0.0) {
         double tau;
         h = left;
+        if (c->max_h > 0.0 && h > c->max_h * (1.0 + LC_CONTACT_CUT_EPSILON)) h = c->max_h;
         if (applied(c) != 0) return -1;
         /* the step's first search is usually the last step's end search, kept */
         c->start_h = h;
@@ -567,7 +568,7 @@ static int advance(lc_contact_island *c, double dt, double e0, double size0, int
         tau = c->small && cuts < LC_CONTACT_MAX_CUTS ? first_transition(c, t, rows, *nt, h) : 1.0;
         if (tau < 1.0 - LC_CONTACT_CUT_EPSILON) {
             /* solved again over the part of the step before the transition */
-            h = tau * left;
+            h = tau * h;
             if (flow(c, t, *nt, h, rows) != 0) return -1;
             cuts++;
             w->last.contact_cuts++;
@@ -588,6 +589,16 @@ static int advance(lc_contact_island *c, double dt, double e0, double size0, int
         c->unpaid > LC_CONTACT_ENERGY_LEFT * size0)
         return -3;
     return 0;
+}
+
+/* The island back at its start (states, contacts and impact events of the try undone), for a retry. */
+static void undo_try(lc_world *w, const lc_island *isl, const double *start, int ncontacts, int nevents)
+{
+    int i;
+    w->last.contact_precise_retries++;
+    for (i = 0; i < isl->nrows; ++i) memcpy(&w->state[isl->rows[i] * 6], &start[i * 6], 6 * sizeof(double));
+    w->contact_count = ncontacts;
+    lc_events_unstage(w->events, nevents);
 }
 
 int lc_contact_advance(lc_world *w, lc_contact_regime *cr, const lc_island *isl, double dt)
@@ -616,11 +627,15 @@ int lc_contact_advance(lc_world *w, lc_contact_regime *cr, const lc_island *isl,
     if (status == -3) {
         /* once more with every solve run to convergence (solve()): a nearly resting island whose solve
          * stopped at contact_iterations can end overlapping or with a gain its kinetic energy cannot pay */
-        w->last.contact_precise_retries++;
-        for (i = 0; i < isl->nrows; ++i) memcpy(&w->state[isl->rows[i] * 6], &start[i * 6], 6 * sizeof(double));
-        w->contact_count = ncontacts;
-        lc_events_unstage(w->events, nevents);
+        undo_try(w, isl, start, ncontacts, nevents);
         c.precise = 1;
+        status = advance(&c, dt, e0, size0, &nend, &nt, &h);
+    }
+    if (status == -3 && isl->nrows > LC_CONTACT_EVENT_FALLBACK_BODIES) {
+        /* an island too large for the event regime: once more, precise, in LC_CONTACT_SPLIT_SUBSTEPS
+         * sub-steps, whose velocities drift less between solves (tunables.h) */
+        undo_try(w, isl, start, ncontacts, nevents);
+        c.max_h = dt / LC_CONTACT_SPLIT_SUBSTEPS;
         status = advance(&c, dt, e0, size0, &nend, &nt, &h);
     }
     if (status == -3 && isl->nrows > LC_CONTACT_EVENT_FALLBACK_BODIES) {

@@ -148,6 +148,12 @@
  * hit by a box: seconds for one step), and the gain such a step keeps is what its precise solve left,
  * ~1e-10 of the island's energy in that pyramid (bench/contact.py's drop12). */
 #define LC_CONTACT_EVENT_FALLBACK_BODIES 8
+/* Sub-steps of the last retry of such a larger island before it keeps its step: a nearly resting
+ * island's unconverged velocities carry its bodies into each other over a step, and the projection
+ * lifts them out higher than they sank; over a quarter of the step they drift a quarter as far (a box
+ * dropped on a base-12 pyramid: a resting pyramid's precise step kept 6.6e-6 J, 2e-9 of the island's
+ * energy; in 2 sub-steps 2.6e-6 J; in 4 it met the allowance, bench/contact.py drop12). */
+#define LC_CONTACT_SPLIT_SUBSTEPS 4
 /* Sweeps over which a contact solve's largest change must halve, or the solve stops as stalled (a
  * precise retry runs its sweeps out). */
 #ifndef LC_CONTACT_STALL_SWEEPS   /* -D to measure */
