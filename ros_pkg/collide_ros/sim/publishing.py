@@ -2,14 +2,14 @@
 energy (state_rate), /tf, markers and /clock; the laser scans are scanners.py's. The bulk messages are
 written as CDR bytes with numpy (cdr.py, markers.py); the contacts message takes the impacts since the
 last one from the world's impact event stream, which keeps them across steps
-(docs/events_and_snapshots.md)."""
+(docs/events_and_snapshots.md). The poses are computed once per publish round (pose_frame.py) and shared
+by the topics due after a step; nothing per body runs in Python."""
 from __future__ import annotations
 
 from typing import Any
 
 import numpy as np
-from builtin_interfaces.msg import Time
-from geometry_msgs.msg import PoseArray, Vector3
+from geometry_msgs.msg import PoseArray
 from libcollide_msgs.msg import BodyStates, Contacts, Energy
 from rosgraph_msgs.msg import Clock
 from tf2_msgs.msg import TFMessage
@@ -18,6 +18,7 @@ from visualization_msgs.msg import MarkerArray
 import collide
 
 from collide_ros import cdr, markers, qos
+from collide_ros.sim.pose_frame import PoseFrame
 
 # Contacts per contacts message (impacts since the last one first, then resting contacts). Impacts
 # past it stay in the world's event stream for the next message; resting contacts past it are dropped
@@ -69,7 +70,7 @@ def concat_rows(parts: list[np.ndarray]) -> np.ndarray:
 class Publishing:
     """Owns the publishers of the state topics (``_pub_poses``, ``_pub_states``, ``_pub_contacts``,
     ``_pub_energy``, ``_pub_clock`` (None with publish_clock false), ``_pub_tf``, ``_pub_markers``), their
-    CDR writers (``_cdr_*``), the publish periods in steps (``_every_*``) and the counts of what the
+    CDR writers (``_cdr_*``), the poses of the current publish round (``_frame``), the publish periods in steps (``_every_*``) and the counts of what the
     contacts messages left out (``dropped_contacts``, ``dropped_impacts``)."""
 
     def _init_publishing(self) -> None:
@@ -103,6 +104,8 @@ class Publishing:
         prefix = self._p["frame_prefix"]
         self._cdr_tf = cdr.TFMessageCdr(frame, [prefix + n for n in self._dyn_names])
         self._cdr_contacts = cdr.ContactsCdr(frame, self._name_of_id)
+        self._cdr_energy = cdr.EnergyCdr(frame)
+        self._frame = PoseFrame(self._dyn_rows, len(self._names))
         outlines, colors = [], []
         for i, n in enumerate(self._names):
             outlines.append(self._bodies[n].local_vertices())
@@ -118,35 +121,32 @@ class Publishing:
         if self._pub_clock is not None and self._every_clock and s % self._every_clock == 0:
             sec, ns = cdr.split_time(self.sim_time)
             self._pub_clock.publish(cdr.clock_cdr(sec, ns))
-        if s % self._every_state == 0:
-            self._publish_state()
-        if self._every_tf and s % self._every_tf == 0:
-            self._publish_tf()
-        if self._every_marker and s % self._every_marker == 0:
-            self._publish_markers()
+        state = s % self._every_state == 0
+        tf = bool(self._every_tf) and s % self._every_tf == 0
+        marker = bool(self._every_marker) and s % self._every_marker == 0
+        if state or tf or marker:
+            self._frame.refresh(self.world.state)
+        if state:
+            self._publish_state(refreshed=True)
+        if tf:
+            self._publish_tf(refreshed=True)
+        if marker:
+            self._publish_markers(refreshed=True)
         if self._scanners:
             self._publish_scans(s)
 
     def _stamp(self) -> tuple[int, int]:
         return cdr.split_time(self.sim_time)
 
-    def _publish_state(self) -> None:
+    def _publish_state(self, refreshed: bool = False) -> None:
+        """bodies/poses, bodies/states, energy, contacts; ``refreshed``: ``_frame`` holds the current state."""
+        if not refreshed:
+            self._frame.refresh(self.world.state)
         sec, ns = self._stamp()
-        st = self.world.state[self._dyn_rows]
-        poses = cdr.poses_from_state(st)
-        self._pub_poses.publish(self._cdr_poses.encode(sec, ns, poses))
-        self._pub_states.publish(self._cdr_states.encode(sec, ns, poses, cdr.twists_from_state(st)))
-        stamp = Time(sec=sec, nanosec=ns)
-        frame = self._p["world_frame"]
-        e = self.world.energy
-        em = Energy()
-        em.header.stamp = stamp
-        em.header.frame_id = frame
-        em.translational, em.rotational = float(e.translational), float(e.rotational)
-        em.gravitational, em.spring, em.total = float(e.gravitational), float(e.spring), float(e.total)
-        em.linear_momentum = Vector3(x=float(e.linear_momentum[0]), y=float(e.linear_momentum[1]), z=0.0)
-        em.angular_momentum = float(e.angular_momentum)
-        self._pub_energy.publish(em)
+        f = self._frame
+        self._pub_poses.publish(self._cdr_poses.encode(sec, ns, f.dyn_poses))
+        self._pub_states.publish(self._cdr_states.encode(sec, ns, f.dyn_poses, f.dyn_twists))
+        self._pub_energy.publish(self._cdr_energy.encode(sec, ns, self.world.energy))
         self._pub_contacts.publish(self._cdr_contacts.encode(sec, ns, self._take_contacts()))
 
     def _take_contacts(self) -> np.ndarray:
@@ -168,15 +168,18 @@ class Publishing:
             return resting.copy()
         return concat_rows([impacts, resting]) if len(resting) else impacts
 
-    def _publish_tf(self) -> None:
+    def _publish_tf(self, refreshed: bool = False) -> None:
+        if not refreshed:
+            self._frame.refresh(self.world.state)
         sec, ns = self._stamp()
-        st = self.world.state[self._dyn_rows]
-        self._pub_tf.publish(self._cdr_tf.encode(sec, ns, cdr.poses_from_state(st)))
+        self._pub_tf.publish(self._cdr_tf.encode(sec, ns, self._frame.dyn_poses))
 
-    def _publish_markers(self, reset: bool = False) -> None:
+    def _publish_markers(self, reset: bool = False, refreshed: bool = False) -> None:
         """The bodies, springs and contacts; ``reset``: headed by a DELETEALL (a new scene)."""
+        if not refreshed:
+            self._frame.refresh(self.world.state)
         sec, ns = self._stamp()
-        poses = cdr.poses_from_state(self.world.state)
+        poses = self._frame.all_poses
         ends = [(np.asarray(a), np.asarray(b)) for a, b in (e.spring.endpoints() for e in self._springs.values())]
         extras = markers.spring_markers(ends)
         c = self.world.contacts
