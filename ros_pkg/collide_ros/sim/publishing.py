@@ -3,7 +3,8 @@ energy (state_rate), /tf, markers and /clock; the laser scans are scanners.py's.
 written as CDR bytes with numpy (cdr.py, markers.py); the contacts message takes the impacts since the
 last one from the world's impact event stream, which keeps them across steps
 (docs/events_and_snapshots.md). The poses are computed once per publish round (pose_frame.py) and shared
-by the topics due after a step; nothing per body runs in Python."""
+by the topics due after a step; nothing per body runs in Python. A round is read from the world on the
+stepping thread and, in the stepping loop, written and sent by the publish thread (publish_thread.py)."""
 from __future__ import annotations
 
 from collections.abc import Callable
