@@ -3,7 +3,7 @@ bodies and for 200 boxes tumbling with friction.
 
     source scripts/env.sh && nice python bench/node_bench.py [--seconds 5] [--windows 3] [--trials 25]
                                                              [--drop-seconds 3] [--bodies 6 1000 pile200 pile200@0.005]
-                                                             [--param publish_thread:=false ...]
+                                                             [--param publish_thread:=true ...]
 
 For each case a node runs in its own process at the node's default parameters (given explicitly on its
 command line): 1 kHz physics (time_step 0.001 s), 100 Hz poses/states, 50 Hz /tf, 20 Hz markers,
@@ -404,7 +404,7 @@ def main() -> int:
                     metavar="CASE", help="body counts (6, 1000, ...) and piles (pile200); default: "
                     + " ".join(DEFAULT_CASES))
     ap.add_argument("--param", action="append", default=[], metavar="NAME:=VALUE",
-                    help="another node parameter for every case (e.g. publish_thread:=false); repeatable")
+                    help="another node parameter for every case (e.g. publish_thread:=true); repeatable")
     a = ap.parse_args()
     lock = pick_domain()
     os.environ.setdefault("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")

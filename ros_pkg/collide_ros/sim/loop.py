@@ -1,8 +1,9 @@
 """The node's threads: the calling thread steps the world on a sleep-until schedule (step k is due at
 ref + k * time_step / real_time_factor of wall time) and publishes /diagnostics once a second; a second
-thread runs the executor (commands, services, parameters); both take the node's lock (guards.py). A third
-writes and sends each step's publish round while the calling thread takes the next step
-(publish_thread.py): the period is bounded by the larger of physics and publishing, not their sum."""
+thread runs the executor (commands, services, parameters); both take the node's lock (guards.py). With
+the parameter publish_thread a third writes and sends each step's publish round while the calling thread
+takes the next step (publish_thread.py): given a spare core, the period is bounded by the larger of
+physics and publishing, not their sum."""
 from __future__ import annotations
 
 import threading
