@@ -3,6 +3,7 @@ bodies and for 200 boxes tumbling with friction.
 
     source scripts/env.sh && nice python bench/node_bench.py [--seconds 5] [--windows 3] [--trials 25]
                                                              [--drop-seconds 3] [--bodies 6 1000 pile200 pile200@0.005]
+                                                             [--param publish_thread:=true ...]
 
 For each case a node runs in its own process at the node's default parameters (given explicitly on its
 command line): 1 kHz physics (time_step 0.001 s), 100 Hz poses/states, 50 Hz /tf, 20 Hz markers,
@@ -11,8 +12,9 @@ real-time factor 1. The bench (another process) measures, per window,
 - how often bodies/poses arrives (raw CDR subscription, so the bench itself is not the bottleneck),
   and sim seconds per wall second from the poses' stamps,
 - the node's own /diagnostics (1 Hz wall): real-time factor, step time (the physics step: C's
-  lc_world_step and collecting its impacts) and publish time per step, steps/s, contacts, taken
-  from every message whose second lay inside the window,
+  lc_world_step and collecting its impacts), publish time per step of the stepping loop (reading the
+  round from the world, handing it over) and of the publish thread (writing and sending it, beside the
+  next step), steps/s, contacts, taken from every message whose second lay inside the window,
 and prints the medians over windows (over all those messages for /diagnostics). The node holds real
 time when the median real-time factor is >= 0.99 (of the requested 1). Then the command -> pose
 latency: after ~/reset, one WrenchStamped is published on block1/thrust (block1 at rest); latency =
@@ -213,10 +215,12 @@ def parse_case(text: str) -> Case:
                                      "optionally @time_step")
 
 
-def node_args(case: Case, tmp: Path) -> list[str]:
-    """The node's command line for a case; scene files are written into tmp."""
+def node_args(case: Case, tmp: Path, params: tuple[str, ...] = ()) -> list[str]:
+    """The node's command line for a case (``params``: more NAME:=VALUE); scene files are written into tmp."""
     args = ["-p", f"time_step:={case.time_step!r}", "-p", "state_rate:=100.0", "-p", "tf_rate:=50.0",
             "-p", "marker_rate:=20.0", "-p", "real_time_factor:=1.0"]
+    for p in params:
+        args += ["-p", p]
     if case.pile:
         path = tmp / f"bench_pile{case.bodies}.yaml"
         path.write_text(yaml.safe_dump(pile_scene(case.bodies)))
@@ -316,7 +320,8 @@ class Bench:
         return lat
 
 
-DIAG_KEYS = ("real_time_factor", "step_time_mean_ms", "publish_time_mean_ms", "steps_per_second", "contacts")
+DIAG_KEYS = ("real_time_factor", "step_time_mean_ms", "publish_time_mean_ms", "publish_thread_time_mean_ms",
+             "steps_per_second", "contacts")
 
 
 def summarize(case: Case, windows: list[Window], lat: list[float]) -> dict[str, float]:
@@ -336,7 +341,8 @@ def summarize(case: Case, windows: list[Window], lat: list[float]) -> dict[str, 
     return out
 
 
-def run_case(case: Case, seconds: float, windows: int, trials: int, drop_seconds: float) -> dict[str, float]:
+def run_case(case: Case, seconds: float, windows: int, trials: int, drop_seconds: float,
+             params: tuple[str, ...] = ()) -> dict[str, float]:
     import rclpy
 
     from collide_ros.testing import NodeProcess, SimClient
@@ -344,7 +350,7 @@ def run_case(case: Case, seconds: float, windows: int, trials: int, drop_seconds
     tmp = Path(tempfile.mkdtemp())
     ctx = rclpy.Context()
     rclpy.init(context=ctx)
-    proc = NodeProcess(*node_args(case, tmp))
+    proc = NodeProcess(*node_args(case, tmp, params))
     client = SimClient(context=ctx, watch=("diagnostics",))
     bench = Bench(client, proc.proc.pid)
     try:
@@ -364,11 +370,13 @@ def run_case(case: Case, seconds: float, windows: int, trials: int, drop_seconds
         shutil.rmtree(tmp, ignore_errors=True)
 
 
-def print_table(cases: list[Case], rows: list[dict[str, float]], drop_seconds: float) -> None:
+def print_table(cases: list[Case], rows: list[dict[str, float]], drop_seconds: float,
+                params: tuple[str, ...] = ()) -> None:
     print(f"\nsim node, time_step as given per case (default 1 ms), 100 Hz poses/states, 50 Hz tf, 20 Hz markers, RTF 1; "
-          f"{os.cpu_count()} cores; ROS_DOMAIN_ID {os.environ['ROS_DOMAIN_ID']}; medians\n")
+          f"{os.cpu_count()} cores; ROS_DOMAIN_ID {os.environ['ROS_DOMAIN_ID']}; load average {os.getloadavg()[0]:.2f}; "
+          "medians" + (f"; node parameters {' '.join(params)}" if params else "") + "\n")
     print("| bodies | node CPU (% of a core) | poses received (Hz) | real-time factor | real time (>= 0.99) "
-          "| step (ms) | publishing per step (ms) | command -> pose p50 / p90 (ms) | trials |")
+          "| step (ms) | publishing per step: loop / publish thread (ms) | command -> pose p50 / p90 (ms) | trials |")
     print("|---|---|---|---|---|---|---|---|---|")
     for case, r in zip(cases, rows):
         name = f"{case.bodies} (pile, first {drop_seconds:g} s of each drop)" if case.pile else str(case.bodies)
@@ -376,7 +384,7 @@ def print_table(cases: list[Case], rows: list[dict[str, float]], drop_seconds: f
         rtf = r["real_time_factor"]
         holds = "n/a (no diagnostics)" if np.isnan(rtf) else "yes" if rtf >= 0.99 else "no"
         print(f"| {name} | {r['cpu_percent']:.1f} | {r['poses_hz']:.1f} | {r['real_time_factor']:.3f} | {holds} "
-              f"| {r['step_time_mean_ms']:.4f} | {r['publish_time_mean_ms']:.4f} "
+              f"| {r['step_time_mean_ms']:.4f} | {r['publish_time_mean_ms']:.4f} / {r['publish_thread_time_mean_ms']:.4f} "
               f"| {r['latency_p50_ms']:.1f} / {r['latency_p90_ms']:.1f} | {int(r['trials'])} |")
     print("\nreal-time factor, step and publishing: medians of the node's /diagnostics (1 Hz) in the windows; "
           "also from the poses' stamps (sim s / wall s), diagnostics used, steps/s, contacts:")
@@ -395,11 +403,13 @@ def main() -> int:
     ap.add_argument("--bodies", type=parse_case, nargs="+", default=[parse_case(c) for c in DEFAULT_CASES],
                     metavar="CASE", help="body counts (6, 1000, ...) and piles (pile200); default: "
                     + " ".join(DEFAULT_CASES))
+    ap.add_argument("--param", action="append", default=[], metavar="NAME:=VALUE",
+                    help="another node parameter for every case (e.g. publish_thread:=true); repeatable")
     a = ap.parse_args()
     lock = pick_domain()
     os.environ.setdefault("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
-    rows = [run_case(c, a.seconds, a.windows, a.trials, a.drop_seconds) for c in a.bodies]
-    print_table(a.bodies, rows, a.drop_seconds)
+    rows = [run_case(c, a.seconds, a.windows, a.trials, a.drop_seconds, tuple(a.param)) for c in a.bodies]
+    print_table(a.bodies, rows, a.drop_seconds, tuple(a.param))
     if lock is not None:
         lock.release()  # type: ignore[attr-defined]
     return 0

@@ -106,26 +106,92 @@ def join_time(t: Any) -> float:
     return t.sec + 1e-9 * t.nanosec
 
 
-def poses_from_state(state: np.ndarray) -> np.ndarray:
-    """(n, >=3) rows x, y, angle -> (n, 7) geometry_msgs/Pose doubles (z = 0, quaternion from yaw)."""
+def poses_from_state(state: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
+    """(n, >=3) rows x, y, angle -> (n, 7) geometry_msgs/Pose doubles (z = 0, quaternion from yaw),
+    written into ``out`` (n, 7) when given (its columns 2-4 must be zero: they are not written)."""
     n = state.shape[0]
-    out = np.zeros((n, 7))
+    if out is None:
+        out = np.zeros((n, 7))
     out[:, 0] = state[:, 0]
     out[:, 1] = state[:, 1]
+    # sin and cos of a contiguous array, copied into the strided columns after: numpy's vectorized
+    # loops for contiguous input are the ones every caller gets, so the bits do not depend on ``out``
     half = 0.5 * state[:, 2]
     out[:, 5] = np.sin(half)
     out[:, 6] = np.cos(half)
     return out
 
 
-def twists_from_state(state: np.ndarray) -> np.ndarray:
-    """(n, 6) state rows -> (n, 6) geometry_msgs/Twist doubles (vx, vy, 0, 0, 0, omega)."""
+def twists_from_state(state: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
+    """(n, 6) state rows -> (n, 6) geometry_msgs/Twist doubles (vx, vy, 0, 0, 0, omega), written into
+    ``out`` (n, 6) when given (its columns 2-4 must be zero)."""
     n = state.shape[0]
-    out = np.zeros((n, 6))
+    if out is None:
+        out = np.zeros((n, 6))
     out[:, 0] = state[:, 3]
     out[:, 1] = state[:, 4]
     out[:, 5] = state[:, 5]
     return out
+
+
+# A scatter through strided views costs one numpy call per run of equally spaced blocks; past this
+# many blocks per run on average a fancy index (one call, ~4x slower per element) is the cheaper one.
+_MIN_BLOCKS_PER_RUN = 16
+
+
+def _runs(starts: np.ndarray, limit: int) -> list[tuple[int, int, int]] | None:
+    """(first block, blocks, step) of each maximal run of equally spaced ``starts`` (increasing), or
+    None when there are more than ``limit`` runs."""
+    n = len(starts)
+    d = np.diff(starts)
+    change = np.flatnonzero(np.diff(d)) + 1  # j: d[j] != d[j - 1]
+    out: list[tuple[int, int, int]] = []
+    i = 0
+    while i < n:
+        if len(out) >= limit:
+            return None
+        if i == n - 1:
+            out.append((i, 1, 1))
+            break
+        k = int(np.searchsorted(change, i, side="right"))
+        end = int(change[k]) if k < len(change) else len(d)  # d[i:end] are all equal
+        out.append((i, end - i + 1, int(d[i])))
+        i = end + 1
+    return out
+
+
+class _Blocks:
+    """Blocks of ``k`` consecutive elements of ``flat`` that start at ``starts`` (element indices,
+    increasing): ``write(values)`` puts row i of values (n, k), or one row (k,) for all, into block i.
+
+    Templates repeat one layout per body, so the starts fall into a few runs of equal spacing (a run
+    per name length); each run is then one strided view of ``flat`` and a write is one copy per run.
+    Starts without such runs (names of many lengths in turn) take one fancy index instead."""
+
+    def __init__(self, flat: np.ndarray, starts: np.ndarray, k: int) -> None:
+        starts = np.asarray(starts, dtype=np.int64)
+        self.n = len(starts)
+        self._views: list[tuple[int, int, np.ndarray]] | None = None
+        self._flat, self._idx = flat, None
+        runs = _runs(starts, max(1, self.n // _MIN_BLOCKS_PER_RUN)) if self.n else []
+        if runs is None:
+            self._idx = starts[:, None] + np.arange(k)
+            return
+        size = flat.itemsize
+        self._views = [(i, i + count, np.lib.stride_tricks.as_strided(
+            flat[int(starts[i]):], shape=(count, k), strides=(step * size, size)))
+            for i, count, step in runs]
+
+    def write(self, values: np.ndarray) -> None:
+        if self._views is None:
+            self._flat[self._idx] = values
+            return
+        if values.ndim == 1:
+            for _, _, view in self._views:
+                view[...] = values
+            return
+        for a, b, view in self._views:
+            view[...] = values[a:b]
 
 
 class _Template:
@@ -142,24 +208,21 @@ class _Template:
         u32_len = (size - _HDR) // 4 * 4
         self._u32 = self._raw[8:8 + u32_len].view("<u4")
         st = np.asarray(stamp_offsets, dtype=np.int64) - _HDR
-        self._sec_idx = st // 4
+        self._stamps = _Blocks(self._u32, st // 4, 2)
         self._dbl = {k: (np.asarray(v, dtype=np.int64) - _HDR) // 8 for k, v in double_offsets.items()}
-        self._idx_cache: dict[tuple[str, int], np.ndarray] = {}
+        self._blocks: dict[tuple[str, int], _Blocks] = {}
 
     def set_stamp(self, sec: int, nanosec: int) -> None:
         # sec is int32, but as it is never negative here the same bits fit a uint32 view.
-        self._u32[self._sec_idx] = np.uint32(sec)
-        self._u32[self._sec_idx + 1] = np.uint32(nanosec)
+        self._stamps.write(np.array([sec, nanosec], dtype=np.uint32))
 
     def set_doubles(self, key: str, values: np.ndarray) -> None:
         """values (n, k): row i goes to the i-th block registered under ``key``."""
-        starts = self._dbl[key]
         k = values.shape[1]
-        idx = self._idx_cache.get((key, k))
-        if idx is None:
-            idx = (starts[:, None] + np.arange(k)).ravel()
-            self._idx_cache[(key, k)] = idx
-        self._f64[idx] = values.ravel()
+        blocks = self._blocks.get((key, k))
+        if blocks is None:
+            blocks = self._blocks[(key, k)] = _Blocks(self._f64, self._dbl[key], k)
+        blocks.write(values)
 
     def set_block(self, key: str, values: np.ndarray) -> None:
         """values written contiguously starting at the single offset registered under ``key``."""
@@ -240,6 +303,28 @@ class TFMessageCdr:
 def clock_cdr(sec: int, nanosec: int) -> bytes:
     """rosgraph_msgs/Clock."""
     return ENCAPSULATION + struct.pack("<iI", sec, nanosec)
+
+
+class EnergyCdr:
+    """libcollide_msgs/Energy: header, translational, rotational, gravitational, spring, total,
+    linear_momentum (x, y, 0), angular_momentum (all float64)."""
+
+    def __init__(self, frame_id: str) -> None:
+        w = CdrWriter()
+        s = w.header(0, 0, frame_id)
+        p = w.f64s(np.zeros(9))
+        self._t = _Template(w, [s], {"energy": np.array([p])})
+        self._values = np.zeros(9)
+
+    def encode(self, sec: int, nanosec: int, energy: Any) -> bytes:
+        """``energy``: a collide.Energy (or anything with its fields)."""
+        v = self._values
+        v[0:5] = (energy.translational, energy.rotational, energy.gravitational, energy.spring, energy.total)
+        v[5:7] = energy.linear_momentum[0], energy.linear_momentum[1]
+        v[8] = energy.angular_momentum
+        self._t.set_stamp(sec, nanosec)
+        self._t.set_block("energy", v)
+        return self._t.tobytes()
 
 
 # ---------------------------------------------------------------- libcollide_msgs/Contacts

@@ -130,13 +130,15 @@ class MarkerArrayCdr:
             t.set_stamp(sec, nanosec)
             if len(poses):
                 t.set_doubles("pose", poses)
-        head = t.tobytes()
         if not extras:
-            return head
-        w = CdrWriter(start=self._end)
+            return t.tobytes()
+        # The extras only need the template's end modulo 8 (CDR alignment), not a copy of its bytes;
+        # template and extras are copied once, into the message.
+        lead = self._end % 8
+        w = CdrWriter(start=lead)
         for m in extras:
             write_marker(w, m, sec, nanosec, self.frame_id)
-        return head + bytes(w.buf[len(ENCAPSULATION) + self._end:])
+        return b"".join((t.buf.data, memoryview(w.buf)[len(ENCAPSULATION) + lead:]))
 
 
 DELETE_ALL = MarkerSpec("", 0, 0, DELETEALL)

@@ -68,6 +68,11 @@ SPECS: tuple[Spec, ...] = (
     Spec("max_body_topics", 64, "Bodies (in row order) that get a <body>/thrust subscription", 0, 100000,
          read_only=True),
     Spec("start_paused", False, "Start paused (use ~/step or ~/pause)", read_only=True),
+    Spec("publish_thread", False, "Write and send each step's messages on a thread of their own while the loop "
+         "takes the next step (C's step releases the GIL): the period is bounded by the larger of physics and "
+         "publishing instead of their sum, given a spare core; without one the threads take turns and hand "
+         "the GIL back and forth, which is slower than false (publishing on the stepping thread)",
+         read_only=True),
     Spec("allow_kill_static", False, "~/kill may remove static bodies (the walls of the box); false keeps them"),
 )
 

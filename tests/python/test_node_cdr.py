@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from builtin_interfaces.msg import Time
 from geometry_msgs.msg import Point, Pose, PoseArray, Quaternion, TransformStamped, Twist, Vector3
-from libcollide_msgs.msg import BodyStates, Contact, Contacts
+from libcollide_msgs.msg import BodyStates, Contact, Contacts, Energy
 from rclpy.serialization import deserialize_message, serialize_message
 from rosgraph_msgs.msg import Clock
 from std_msgs.msg import ColorRGBA
@@ -96,6 +96,62 @@ def test_tf_message(children: list[str]) -> None:
         t.transform.rotation = p.orientation
         msg.transforms.append(t)
     check(raw, msg)
+
+
+def tf_msg(children: list[str], st: np.ndarray, sec: int, ns: int) -> TFMessage:
+    msg = TFMessage()
+    for child, r in zip(children, st):
+        t = TransformStamped()
+        t.header.stamp = Time(sec=sec, nanosec=ns)
+        t.header.frame_id = "world"
+        t.child_frame_id = child
+        p = pose_msg(r)
+        t.transform.translation = Vector3(x=p.position.x, y=p.position.y, z=0.0)
+        t.transform.rotation = p.orientation
+        msg.transforms.append(t)
+    return msg
+
+
+# The template writes a repeated block through one strided view per run of equally spaced blocks
+# (b1 ... b999: a run per name length that changes the padding), or, when the runs are short (names
+# of many lengths in turn), through one fancy index: both layouts, each encoded twice.
+@pytest.mark.parametrize("children", [[f"p/b{k}" for k in range(1, 1000)],
+                                      ["x" * (1 + k % 13) for k in range(300)]],
+                         ids=["runs", "fancy"])
+def test_tf_message_many(children: list[str]) -> None:
+    w = cdr.TFMessageCdr("world", children)
+    blocks = w._t._blocks
+    for sec, ns in ((99, 123), (100, 999_999_999)):
+        st = random_state(len(children))
+        check(w.encode(sec, ns, cdr.poses_from_state(st)), tf_msg(children, st, sec, ns))
+    runs = blocks[("tf", 7)]._views
+    assert (runs is not None and len(runs) <= 8) == (children[0] == "p/b1")
+
+
+def test_poses_and_twists_into_out() -> None:
+    # a caller's preallocated arrays get the same bits as fresh ones, also when reused
+    out_p, out_t = np.zeros((50, 7)), np.zeros((50, 6))
+    for _ in range(2):
+        st = random_state(50)
+        assert cdr.poses_from_state(st, out=out_p) is out_p
+        assert cdr.twists_from_state(st, out=out_t) is out_t
+        assert cdr.poses_from_state(st).tobytes() == out_p.tobytes()
+        assert cdr.twists_from_state(st).tobytes() == out_t.tobytes()
+
+
+@pytest.mark.parametrize("frame", ["", "w", "world", "world_frame"])
+def test_energy(frame: str) -> None:
+    e = collide.Energy(*RNG.normal(size=5), tuple(RNG.normal(size=2)), *RNG.normal(size=2))
+    w = cdr.EnergyCdr(frame)
+    for sec, ns in ((4, 5), (6, 999_999_999)):
+        msg = Energy()
+        msg.header.stamp = Time(sec=sec, nanosec=ns)
+        msg.header.frame_id = frame
+        msg.translational, msg.rotational = float(e.translational), float(e.rotational)
+        msg.gravitational, msg.spring, msg.total = float(e.gravitational), float(e.spring), float(e.total)
+        msg.linear_momentum = Vector3(x=float(e.linear_momentum[0]), y=float(e.linear_momentum[1]), z=0.0)
+        msg.angular_momentum = float(e.angular_momentum)
+        check(w.encode(sec, ns, e), msg)
 
 
 def test_clock() -> None:

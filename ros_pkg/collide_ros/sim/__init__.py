@@ -8,6 +8,8 @@ commands      the command topics: thrust, thrusters, spring, cmd_vel; echoes on 
 forces        commands turned into each step's external forces (timeouts, the cmd_vel servo)
 stepping      one physics step, split into parts when C undoes it, and what is due after it
 publishing    poses, states, contacts, energy, /tf, markers, /clock
+pose_frame    the bodies' poses and twists of one publish round, computed once and shared by the topics
+publish_thread the thread that writes and sends the stepping loop's publish rounds beside the next step
 scanners      laser scanners on bodies (the scene's ``scanners``): sensor_msgs/LaserScan from C ray casts
 diagnostics   the /diagnostics status
 services      ~/reset, ~/pause, ~/step, ~/kill

@@ -52,6 +52,7 @@ class Diagnostics:
             "step_time_mean_ms": f"{1e3 * self._step_time_sum / n:.4f}",
             "step_time_max_ms": f"{1e3 * self._step_time_max:.4f}",
             "publish_time_mean_ms": f"{1e3 * self._pub_time_sum / n:.4f}",
+            "publish_thread_time_mean_ms": f"{1e3 * self._publish_thread_time() / n:.4f}",
             "steps_per_second": f"{self._window_steps / dw:.1f}", "late_steps": str(self.late_steps),
             "cpu_percent": f"{100 * self.last_cpu:.1f}", "bodies": str(len(self._names)),
             "dynamic_bodies": str(len(self._dyn_names)), "contacts": str(len(self.world.contacts)),

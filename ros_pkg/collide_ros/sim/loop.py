@@ -1,6 +1,9 @@
-"""The node's two threads: the calling thread steps the world on a sleep-until schedule (step k is due at
+"""The node's threads: the calling thread steps the world on a sleep-until schedule (step k is due at
 ref + k * time_step / real_time_factor of wall time) and publishes /diagnostics once a second; a second
-thread runs the executor (commands, services, parameters). Both take the node's lock (guards.py)."""
+thread runs the executor (commands, services, parameters); both take the node's lock (guards.py). With
+the parameter publish_thread a third writes and sends each step's publish round while the calling thread
+takes the next step (publish_thread.py): given a spare core, the period is bounded by the larger of
+physics and publishing, not their sum."""
 from __future__ import annotations
 
 import threading
@@ -40,6 +43,9 @@ class Loop:
         ex.add_node(self)
         spinner = threading.Thread(target=self._spin, args=(ex,), name="sim-executor", daemon=True)
         spinner.start()
+        threaded = bool(self._p["publish_thread"])
+        if threaded:
+            self._start_publish_thread()
         ref_wall = time.perf_counter()
         ref_steps = 0
         next_diag = ref_wall + 1.0
@@ -69,7 +75,7 @@ class Loop:
                 with self._lock:
                     if self._paused or self._schedule_dirty:
                         continue
-                    self.step_once()
+                    self.step_once(threaded=threaded)
                 ref_steps += 1
                 if self._lock_waiters:
                     # A callback waits for the lock (_executor_lock). Without sleeping this loop would
@@ -86,5 +92,7 @@ class Loop:
             if self.context.ok():
                 raise
         finally:
+            with self._lock:
+                self._stop_publish_thread()
             spinner.join(timeout=2.0)
             ex.remove_node(self)

@@ -24,8 +24,8 @@ SPLIT_MAX_SOLVER_WORK_PER_BODY = 1e7
 class Stepping:
     """Owns the step counts (``steps`` since the last build, ``total_steps``, ``split_steps``),
     ``failing_since`` (sim time of the first of the failed steps in a row, or None) and the step and
-    publish times summed for /diagnostics (``_step_time_sum``, ``_step_time_max``, ``_pub_time_sum``,
-    ``_window_steps``)."""
+    publish times summed for /diagnostics (``_step_time_sum``, ``_step_time_max``, ``_pub_time_sum``:
+    the stepping thread's time after the step, ``_window_steps``)."""
 
     def _init_stepping(self) -> None:
         self.steps = 0          # since the last (re)build; drives the publish periods
@@ -77,8 +77,9 @@ class Stepping:
                 n += self._halves(dt / 2, depth + 1)
         return n
 
-    def step_once(self) -> bool:
-        """One physics step and whatever publishing is due; False if the step failed (and was undone)."""
+    def step_once(self, threaded: bool = False) -> bool:
+        """One physics step and whatever publishing is due; False if the step failed (and was undone).
+        ``threaded`` (the stepping loop): the publish thread writes and sends the round (publishing.py)."""
         self._apply_forces()
         t0 = time.perf_counter()
         try:
@@ -104,6 +105,6 @@ class Stepping:
         dt_step = t1 - t0
         self._step_time_sum += dt_step
         self._step_time_max = max(self._step_time_max, dt_step)
-        self._publish_due(self.steps)
+        self._publish_due(self.steps, threaded=threaded)
         self._pub_time_sum += time.perf_counter() - t1
         return True
