@@ -151,8 +151,9 @@
 /* Sub-steps of the last retry of such a larger island before it keeps its step: a nearly resting
  * island's unconverged velocities carry its bodies into each other over a step, and the projection
  * lifts them out higher than they sank; over a quarter of the step they drift a quarter as far (a box
- * dropped on a base-12 pyramid: a resting pyramid's precise step kept 6.6e-6 J, 2e-9 of the island's
- * energy; in 2 sub-steps 2.6e-6 J; in 4 it met the allowance, bench/contact.py drop12). */
+ * dropped on a base-12 pyramid, on a trajectory of bench/contact.py drop12's scene: a resting
+ * pyramid's precise step kept 6.6e-6 J, 2e-9 of the island's energy; in 2 sub-steps 2.6e-6 J; in 4 it
+ * met the allowance). */
 #define LC_CONTACT_SPLIT_SUBSTEPS 4
 /* Sweeps over which a contact solve's largest change must halve, or the solve stops as stalled (a
  * precise retry runs its sweeps out). */
