@@ -85,17 +85,7 @@ def test_tf_message(children: list[str]) -> None:
     st = random_state(len(children))
     w = cdr.TFMessageCdr("world", children)
     raw = w.encode(99, 123, cdr.poses_from_state(st))
-    msg = TFMessage()
-    for child, r in zip(children, st):
-        t = TransformStamped()
-        t.header.stamp = Time(sec=99, nanosec=123)
-        t.header.frame_id = "world"
-        t.child_frame_id = child
-        p = pose_msg(r)
-        t.transform.translation = Vector3(x=p.position.x, y=p.position.y, z=0.0)
-        t.transform.rotation = p.orientation
-        msg.transforms.append(t)
-    check(raw, msg)
+    check(raw, tf_msg(children, st, 99, 123))
 
 
 def tf_msg(children: list[str], st: np.ndarray, sec: int, ns: int) -> TFMessage:
