@@ -18,28 +18,6 @@
 #define MU 0.6
 #define GAIN_TOL 1e-9
 
-static lc_body_id add_box(lc_world *w, double width, double height, double x, double y, double vy, double omega,
-                          double mass, int is_static)
-{
-    lc_vec2 v[4];
-    lc_body_def d = lc_default_body_def();
-    v[0].x = -0.5 * width; v[0].y = -0.5 * height;
-    v[1].x = 0.5 * width;  v[1].y = -0.5 * height;
-    v[2].x = 0.5 * width;  v[2].y = 0.5 * height;
-    v[3].x = -0.5 * width; v[3].y = 0.5 * height;
-    d.vertices = v;
-    d.vertex_count = 4;
-    d.position.x = x;
-    d.position.y = y;
-    d.velocity.y = vy;
-    d.angular_velocity = omega;
-    d.mass = mass;
-    d.elasticity = 0.0;
-    d.friction = MU;
-    d.type = is_static ? LC_BODY_STATIC : LC_BODY_DYNAMIC;
-    return sc_add(w, &d, "pyramid_drop body");
-}
-
 int main(void)
 {
     lc_world_def d = lc_default_world_def();
@@ -49,16 +27,15 @@ int main(void)
     lc_energy en;
     double e_prev, worst = -INFINITY, t_worst = 0.0;
     hc_mon m;
-    int i, j, k;
+    int k;
     d.gravity.x = 0.0;
     d.gravity.y = -10.0;
     d.damping = 0.0;
     w = sc_world(&d);
     if (!w) return CHECK_SUMMARY("test_pyramid_drop");
-    for (i = 0; i < BASE; ++i)
-        for (j = i; j < BASE; ++j) add_box(w, 1.0, 1.0, (i + 1.0) * 0.5 + (j - i) - 0.5 * BASE, 0.5 + i, 0.0, 0.0, 1.0, 0);
-    add_box(w, 2.0 * BASE + 20.0, 1.0, 0.0, -0.5, 0.0, 0.0, 1.0, 1);
-    add_box(w, 1.0, 1.0, 0.3, BASE + 2.0, -8.0, 1.0, 5.0, 0);
+    sc_pyramid(w, BASE, MU, NULL);
+    hc_static(w, 2.0 * BASE + 20.0, 1.0, 0.0, -0.5, 0.0, MU);
+    hc_box(w, 1.0, 1.0, 0.3, BASE + 2.0, 0.0, 0.0, -8.0, 1.0, 5.0, 0.0, MU);
     if (!hc_mon_init(&m, w, "drop on a base-12 pyramid", 1.0 / 60.0, box)) return CHECK_SUMMARY("test_pyramid_drop");
     CHECK(lc_world_get_energy(w, &en) == LC_OK, "%s", "energy");
     e_prev = en.total;
