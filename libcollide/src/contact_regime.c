@@ -5,16 +5,19 @@
  *   2. impacts: points touching (or, in a large island, arriving within the first half of the step)
  *      that approach get the compression impulse that stops every approach, then Poisson's
  *      restitution e j_c where their approach was fast enough to bounce, then a second compression
- *      that stops what the restitution drove into other touches;
+ *      that stops what the restitution drove into other touches; in a Moreau-Jean sub-step (step 5)
+ *      only when a touching point approaches fast enough to bounce;
  *   3. flow: one complementarity problem in the contact impulses over h: with v = v_0 + h M^-1 F + M^-1
  *      J^T lambda, each point's normal velocity at the end keeps its gap at or above the contact gap
- *      under the trapezoidal position update (u_n >= -u_n0 - 2 (gap - contact_gap)^+ / h), Coulomb
+ *      under the sub-step's position update (trapezoidal: u_n >= -u_n0 - 2 (gap - contact_gap)^+ / h;
+ *      Moreau-Jean: u_n >= -(gap - contact_gap)^+ / h), Coulomb
  *      friction in the exact 2D cone, warm-started from the last step's forces (contact_cache.c),
  *      solved by nonsmooth Gauss-Seidel (contact_solver.c), and in a precise retry of few points exactly
  *      (contact_active_set.c, else contact_exact.c);
  *   4. in small islands, a stick-slip transition or a new contact's arrival inside the step cuts the
  *      step there, and the rest is taken again from step 1;
- *   5. positions: x += h (v_0 + v) / 2 (exact under constant forces);
+ *   5. positions: x += h (v_0 + v) / 2 (exact under constant forces), or x += h v (Moreau-Jean) in a
+ *      sub-step of several bodies and fewer than LC_CONTACT_MOREAU_JEAN_POINTS points;
  *   6. a projection moves overlapping points out by the smallest mass-weighted displacement (a large
  *      pass starting from active sets over a sparse factorization: contact_projection.c), and an
  *      island without driving forces that still ends with more energy than it began with gives the
@@ -235,11 +238,12 @@ static void count_solve(lc_contact_island *c, lc_contact_solve s, int rows)
 static int impacts(lc_contact_island *c, lc_touch *t, int nt, double h)
 {
     lc_world *w = c->w;
-    /* Any closed point that approaches is an impact: the trapezoidal update would otherwise have to turn
-     * its approach into an equal separation to keep the gap (an elastic micro-bounce that never
-     * dissipates; a pile at resting_speed 1e-2 kept bodies rocking at 2 mm/s that way). Approaches
-     * slower than contact_tolerance are the solves' own noise. Only approaches faster than
-     * resting_speed count and are reported as collisions. */
+    /* Under the trapezoidal update any closed point that approaches is an impact: the flow would
+     * otherwise have to turn its approach into an equal separation to keep the gap (an elastic
+     * micro-bounce that never dissipates; a pile at resting_speed 1e-2 kept bodies rocking at 2 mm/s
+     * that way). Approaches slower than contact_tolerance are the solves' own noise. Under x += h v
+     * (c->moreau_jean) the flow stops an approach itself, and only one that bounces is an impact. Only
+     * approaches faster than resting_speed count and are reported as collisions. */
     double gc = w->def.contact_gap, vmin = w->def.contact_tolerance;
     double vr = w->def.resting_speed;
     int real = 0, bounced = 0;
@@ -255,9 +259,10 @@ static int impacts(lc_contact_island *c, lc_touch *t, int nt, double h)
         lc_contact_row_velocity(&rows[m], c->b.v0, &un, &ut);
         /* a large island has no located arrivals: a point that would arrive in the first half of the
          * step would need a bounce to keep its gap under the trapezoidal update, so it is an impact now */
-        if (!closed && !(!c->small && un < 0.0 && t[i].gap - gc < -0.5 * un * h)) continue;
+        if (!closed && (c->moreau_jean || !(!c->small && un < 0.0 && t[i].gap - gc < -0.5 * un * h))) continue;
         t[i].vn_pre = un;
-        if (un < -vmin) fast = 1;
+        /* under x += h v the flow itself stops an approach that does not bounce */
+        if (c->moreau_jean ? t[i].elasticity > 0.0 && un < -lc_bounce_speed(w, t[i].elasticity) : un < -vmin) fast = 1;
         which[m++] = i;
     }
     if (!fast) return 0;
@@ -357,7 +362,7 @@ static int flow(lc_contact_island *c, const lc_touch *t, int nt, double h, lc_co
         double un, ut, fn, ft;
         lc_contact_island_row(c, &t[i], r);
         lc_contact_row_velocity(r, c->b.v0, &un, &ut);
-        r->target_n = -un - 2.0 * fmax(t[i].gap - gc, 0.0) / h;
+        r->target_n = c->moreau_jean ? -fmax(t[i].gap - gc, 0.0) / h : -un - 2.0 * fmax(t[i].gap - gc, 0.0) / h;
         r->slip = ut > slip_speed ? 1 : ut < -slip_speed ? -1 : 0;
         known[i] = (uint8_t)lc_contact_cache_find(c->cr->cache, key_of(w, &t[i]), &fn, &ft);
         if (known[i]) {
@@ -408,7 +413,8 @@ static double first_transition(const lc_contact_island *c, const lc_touch *t, co
     return tau;
 }
 
-/* Step 5: positions by the trapezoidal rule; velocities become the solver's. */
+/* Step 5: positions by the trapezoidal rule, or by x += h v in a Moreau-Jean sub-step; velocities
+ * become the solver's. */
 static void advance_positions(lc_contact_island *c, double h)
 {
     lc_world *w = c->w;
@@ -416,7 +422,7 @@ static void advance_positions(lc_contact_island *c, double h)
     for (i = 0; i < c->b.n; ++i) {
         double *s = &w->state[c->isl->rows[i] * 6];
         for (k = 0; k < 3; ++k) {
-            s[k] += 0.5 * h * (c->b.v0[i * 3 + k] + c->b.v[i * 3 + k]);
+            s[k] += c->moreau_jean ? h * c->b.v[i * 3 + k] : 0.5 * h * (c->b.v0[i * 3 + k] + c->b.v[i * 3 + k]);
             s[3 + k] = c->b.v[i * 3 + k];
         }
     }
@@ -563,6 +569,7 @@ static int advance(lc_contact_island *c, double dt, double e0, double size0, int
         t = (lc_touch *)cr->b_touch.p;
         rows = lc_buf_get(&cr->b_rows, (size_t)(*nt > 0 ? *nt : 1) * sizeof(lc_contact_row));
         if (rows == NULL) return -1;
+        c->moreau_jean = !c->small && *nt < LC_CONTACT_MOREAU_JEAN_POINTS;
         for (i = 0; i < isl->nrows; ++i) memcpy(&c->b.v0[i * 3], &w->state[isl->rows[i] * 6 + 3], 3 * sizeof(double));
         if (impacts(c, t, *nt, h) < 0 || flow(c, t, *nt, h, rows) != 0) return -1;
         tau = c->small && cuts < LC_CONTACT_MAX_CUTS ? first_transition(c, t, rows, *nt, h) : 1.0;

@@ -98,19 +98,21 @@ static lc_world *seed_scene(int event_capacity)
     return sc_driven_blocks(d, 7, 0, NULL);
 }
 
-/* A pyramid of base 6 (e 0, friction 0.5) on a floor, and a box (e 0.3) dropped on it at 5 m/s: the
+/* A pyramid of base 7 (e 0, friction 0.5) on a floor, and a box (e 0.3) dropped on it at 5 m/s: the
  * contact regime's impacts. With 1 solver sweep (contact_iterations) the contact regime takes some island
- * steps again with converged solves (lc_counters.contact_precise_retries). */
+ * steps again with converged solves (lc_counters.contact_precise_retries): the pile has more points than
+ * LC_CONTACT_MOREAU_JEAN_POINTS, so its steps keep the trapezoidal update, whose unconverged solves leave
+ * gains the precise retry removes. */
 static lc_world *pile_scene(int contact_iterations)
 {
     lc_world_def d = lc_default_world_def();
     lc_world *w;
-    lc_body_id ids[21];
+    lc_body_id ids[28];
     d.contact_iterations = contact_iterations;
     w = sc_world(&d);
     if (!w) return NULL;
     sc_static_box(w, 40.0, 1.0, 0.0, -0.5, 0.0);
-    sc_pyramid(w, 6, 0.5, ids);
+    sc_pyramid(w, 7, 0.5, ids);
     sc_box(w, 1.0, 1.0, 0.3, 9.0, 0.2, 0.0, -5.0, 0.0, 1.0, 0.3);
     return w;
 }
@@ -216,7 +218,9 @@ static void overflow(void)
     int k, reads = 0;
     lc_world_def d;
     if (!w) return;
-    for (k = 0; k < 600; ++k) {
+    /* 3 s: the driven blocks settle into a resting pile after about 5 s, and the reads below need
+     * impacts still coming */
+    for (k = 0; k < 300; ++k) {
         if (sc_step_n(w, 0.01, 1) != 1) break;
         poll_collisions(w, &model);
         if (model.n > cap) {
