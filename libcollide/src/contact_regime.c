@@ -6,7 +6,7 @@
  *      that approach get the compression impulse that stops every approach, then Poisson's
  *      restitution e j_c where their approach was fast enough to bounce, then a second compression
  *      that stops what the restitution drove into other touches; in a Moreau-Jean sub-step (step 5)
- *      only when a touching point approaches fast enough to bounce;
+ *      only when a touching point approaches faster than resting_speed;
  *   3. flow: one complementarity problem in the contact impulses over h: with v = v_0 + h M^-1 F + M^-1
  *      J^T lambda, each point's normal velocity at the end keeps its gap at or above the contact gap
  *      under the sub-step's position update (trapezoidal: u_n >= -u_n0 - 2 (gap - contact_gap)^+ / h;
@@ -242,8 +242,9 @@ static int impacts(lc_contact_island *c, lc_touch *t, int nt, double h)
      * otherwise have to turn its approach into an equal separation to keep the gap (an elastic
      * micro-bounce that never dissipates; a pile at resting_speed 1e-2 kept bodies rocking at 2 mm/s
      * that way). Approaches slower than contact_tolerance are the solves' own noise. Under x += h v
-     * (c->moreau_jean) the flow stops an approach itself, and only one that bounces is an impact. Only
-     * approaches faster than resting_speed count and are reported as collisions. */
+     * (c->moreau_jean) the flow stops an approach itself, and the stage runs only for one faster than
+     * resting_speed, the collisions every regime reports. Only approaches faster than resting_speed
+     * count and are reported as collisions. */
     double gc = w->def.contact_gap, vmin = w->def.contact_tolerance;
     double vr = w->def.resting_speed;
     int real = 0, bounced = 0;
@@ -261,8 +262,8 @@ static int impacts(lc_contact_island *c, lc_touch *t, int nt, double h)
          * step would need a bounce to keep its gap under the trapezoidal update, so it is an impact now */
         if (!closed && (c->moreau_jean || !(!c->small && un < 0.0 && t[i].gap - gc < -0.5 * un * h))) continue;
         t[i].vn_pre = un;
-        /* under x += h v the flow itself stops an approach that does not bounce */
-        if (c->moreau_jean ? t[i].elasticity > 0.0 && un < -lc_bounce_speed(w, t[i].elasticity) : un < -vmin) fast = 1;
+        /* under x += h v the flow itself stops an approach slower than resting_speed */
+        if (un < -(c->moreau_jean ? vr : vmin)) fast = 1;
         which[m++] = i;
     }
     if (!fast) return 0;

@@ -129,15 +129,16 @@
  * rule a closed point that approaches must end separating as fast (its mean velocity keeps the gap),
  * so every approach the last solve left, however slow, takes an impact solve and a bounce re-solve
  * first: 40-60 % of the sweeps of 30 boxes settling in a box. With x += h v the flow stops such an
- * approach itself (u_n >= -(gap - contact_gap) / h at the end) and only approaches that bounce are
- * impacts. The rule is first order, and loses 1/2 m g^2 h^2 per step to a body in free fall: it
- * dissipates. It needs a converged flow, since a velocity error moves positions twice as far as under
- * the trapezoidal rule: below this size the solves run to contact_tolerance (LC_CONTACT_SMALL_POINTS).
- * In larger islands the sweeps stall and the overlaps and projections that follow cost more than the
- * impacts saved (mixed boxes, bench/contact.py: 30 boxes -33 to -55 % of instructions over four
- * seeds, 100 boxes -15 % to +8 %, and +28 % for the block pushing a row of 40 at 128 points). An
- * island of one body keeps the trapezoidal rule, exact under constant forces (a block sliding to a
- * stop at v^2 / (2 mu g)). */
+ * approach itself (u_n >= -(gap - contact_gap) / h at the end); the impact stage runs only for
+ * approaches faster than resting_speed, which every regime reports as collisions. The rule is first
+ * order, and loses 1/2 m g^2 h^2 per step to a body in free fall: it dissipates. It needs a converged
+ * flow, since a velocity error moves positions twice as far as under the trapezoidal rule: below this
+ * size the solves run to contact_tolerance (LC_CONTACT_SMALL_POINTS). In larger islands the sweeps
+ * stall and the overlaps and projections that follow cost more than the impacts saved (mixed boxes,
+ * bench/contact.py: 30 boxes -30 to -56 % of instructions over three seeds, 100 boxes +17, -17 and -26 %
+ * at this size and up to +35 % at 128 points, the block pushing a row of 40 +28 % at 128). An island
+ * of one body keeps the trapezoidal rule, exact under constant forces (a block sliding to a stop at
+ * v^2 / (2 mu g)). */
 #define LC_CONTACT_MOREAU_JEAN_POINTS 64
 /* When a contact-regime step ends with an overlap it cannot project away or an energy gain the island's
  * kinetic energy cannot pay (a nearly resting island whose solves stopped at contact_iterations, 1e-4

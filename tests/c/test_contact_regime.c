@@ -26,13 +26,15 @@
  *  (6) free flight in the forced contact regime is still the exact parabola (the trapezoidal update
  *      is exact under constant forces): 1e-12 m over 1 s;
  *  (7) a sub-step of a few bodies (fewer than LC_CONTACT_MOREAU_JEAN_POINTS points) moves positions by
- *      x += h v, and its flow stops approaches that do not bounce: the top block of a resting 3-stack
- *      (mu 0.5) set moving down at 0.5 m/s, with e = 0, stops in one step with no impact solve
- *      (impulse_solves 0), every block at rest (|v| <= 1e-9 m/s: the solve's tolerance is 1e-10),
- *      nothing moved (1e-9 m) and exactly its kinetic energy, 0.125 J, lost (1e-9 J); with e = 0.5
- *      the approach bounces, so the impact stage runs, the collision is reported at -0.5 m/s at each
- *      point of the face, and the block leaves at e 0.5 - g h (Poisson's restitution off the resting
- *      stack, then gravity over the step), to 1e-9 m/s. */
+ *      x += h v, and its flow stops approaches slower than resting_speed (1e-4 m/s): the top block of a
+ *      resting 3-stack (mu 0.5) set moving down at 5e-5 m/s stops in one step with no impact solve
+ *      (impulse_solves 0; the trapezoidal update needs one for any approach above contact_tolerance),
+ *      no collision reported, every block at rest (|v| <= 1e-9 m/s: the solve's tolerance is
+ *      1e-10) and no energy gained. At 0.5 m/s the approach is a collision: with e = 0 the impact
+ *      stage runs, reports it at -0.5 m/s at each point of the face, and the block stops, every block
+ *      at rest, nothing moved (1e-9 m) and exactly its kinetic energy, 0.125 J, lost (1e-9 J); with
+ *      e = 0.5 the block leaves at e 0.5 - g h (Poisson's restitution off the resting stack, then
+ *      gravity over the step), to 1e-9 m/s, and the blocks below stay. */
 #include "check.h"
 #include "scenes.h"
 
@@ -260,13 +262,13 @@ static void contact_free_flight(void)
     lc_world_destroy(w);
 }
 
-/* (7): the top block of a resting 3-stack (elasticity e everywhere) hits the block below at 0.5 m/s. */
-static void moreau_jean_substep(double e)
+/* (7): the top block of a resting 3-stack (elasticity e everywhere) hits the block below at speed. */
+static void moreau_jean_substep(double e, double speed)
 {
     lc_world *w = world_with_floor(LC_REGIME_AUTO, e);
     lc_body_id ids[3];
     lc_counters c;
-    lc_vec2 down = {0.0, -0.5};
+    lc_vec2 down = {0.0, 0.0};
     lc_energy e0, e1;
     const lc_contact *cs;
     double y0[3], vmax = 0.0, moved = 0.0, v_hit = 0.0, v_off = 0.0;
@@ -274,6 +276,7 @@ static void moreau_jean_substep(double e)
     if (!w) return;
     for (i = 0; i < 3; ++i) ids[i] = block(w, 0.0, 0.25 + 0.5 * i, 0.0, e);
     run(w, 60);
+    down.y = -speed;
     CHECK(lc_body_set_velocity(w, ids[2], down, 0.0) == LC_OK, "%s", "set the top block moving");
     for (i = 0; i < 3; ++i) y0[i] = sc_row(w, ids[i])[1];
     lc_world_get_energy(w, &e0);
@@ -284,20 +287,26 @@ static void moreau_jean_substep(double e)
         if (cs[i].kind == LC_CONTACT_COLLISION) {
             hits++;
             v_hit = cs[i].normal_velocity;
-            v_off = fmax(v_off, fabs(v_hit + 0.5));
+            v_off = fmax(v_off, fabs(v_hit + speed));
         }
     for (i = 0; i < 3; ++i) {
         if (i < 2 || e == 0.0) vmax = fmax(vmax, hypot(sc_row(w, ids[i])[3], sc_row(w, ids[i])[4]));
         if (i < 2 || e == 0.0) moved = fmax(moved, fabs(sc_row(w, ids[i])[1] - y0[i]));
     }
-    printf("moreau-jean e %.1f: contact islands %llu, impulse solves %llu, collisions %d at %.12f m/s, top vy %.12f, "
-           "others |v| %.3g, moved %.3g m, energy %.12f J\n", e, (unsigned long long)c.contact_islands,
+    printf("moreau-jean e %.1f at %g m/s: contact islands %llu, impulse solves %llu, collisions %d at %.12f m/s, top vy %.12f, "
+           "others |v| %.3g, moved %.3g m, energy %.12f J\n", e, speed, (unsigned long long)c.contact_islands,
            (unsigned long long)c.impulse_solves, hits, v_hit, sc_row(w, ids[2])[4], vmax, moved, e1.total - e0.total);
     CHECK(c.contact_islands == 1, "the stack is one contact-regime island (%llu)", (unsigned long long)c.contact_islands);
-    if (e == 0.0) {
-        CHECK(c.impulse_solves == 0, "an approach that does not bounce takes no impact solve (%llu)",
+    if (speed < 1e-4) {
+        CHECK(c.impulse_solves == 0, "an approach slower than resting_speed takes no impact solve (%llu)",
               (unsigned long long)c.impulse_solves);
         CHECK(hits == 0, "no collision is reported for it (%d)", hits);
+        CHECK(vmax <= 1e-9, "every block rests after the step (max |v| %.3g m/s)", vmax);
+        CHECK(e1.total <= e0.total, "no energy gained (%.3g J)", e1.total - e0.total);
+    } else if (e == 0.0) {
+        CHECK(c.impulse_solves >= 1, "a collision takes the impact stage (%llu)", (unsigned long long)c.impulse_solves);
+        CHECK(hits >= 1 && v_off <= 1e-9, "the impact is reported at -0.5 m/s at each point of the face (%d points, "
+              "off by %.3g m/s)", hits, v_off);
         CHECK(vmax <= 1e-9, "every block rests after the step (max |v| %.3g m/s)", vmax);
         CHECK(moved <= 1e-9, "no block moved (%.3g m)", moved);
         CHECK(fabs(e1.total - e0.total + 0.125) <= 1e-9, "the step lost the top block's 0.125 J (%.12f J)",
@@ -322,7 +331,8 @@ int main(void)
     stack_at_rest();
     solves_cut_short();
     contact_free_flight();
-    moreau_jean_substep(0.0);
-    moreau_jean_substep(0.5);
+    moreau_jean_substep(0.0, 5e-5);
+    moreau_jean_substep(0.0, 0.5);
+    moreau_jean_substep(0.5, 0.5);
     return CHECK_SUMMARY("test_contact_regime");
 }
