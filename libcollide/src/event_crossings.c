@@ -184,8 +184,8 @@ static double circle_gap(const lc_world *w, const double *s, int a, int b)
 }
 
 /* 1 if a vertex of a or b may dip into the other and come back out between s0 and s1 (h apart):
- * the pair ends up closer than its chords can stray. */
-static int may_dip(lc_world *w, const double *s0, const double *s1, double h, int a, int b)
+ * the pair ends up closer than its chords can stray. free_flight: nothing rests (lc_trial.min_part). */
+static int may_dip(lc_world *w, const double *s0, const double *s1, double h, int a, int b, int free_flight)
 {
     double dev = chord_deviation(w, s0, s1, h, a, b), sep0;
     /* a path that strays from its chord by less than a quarter of the contact gap can dip at most
@@ -199,8 +199,12 @@ static int may_dip(lc_world *w, const double *s0, const double *s1, double h, in
         lc_bounds_gap(w, s1, a, b) > dev + w->def.contact_distance)
         return 0;
     sep0 = lc_pair_separation(w, s0, a, b);
-    /* touching at the start: resting contacts or impacts already guard the pair */
-    if (sep0 < w->def.contact_distance) return 0;
+    /* touching at the start: resting contacts guard the pair. In free flight nothing rests, and a
+     * pair touching there has just had an impact, which resolved only its vertices within
+     * contact_distance of the other body: another vertex of the pair, turning in from farther out,
+     * can dip in and back out within the interval unseen by the end points (a block spun by an
+     * impact at one corner, its next corner passing 2 mm deep). That pair is swept as any other. */
+    if (sep0 < w->def.contact_distance && !free_flight) return 0;
     return !(sep0 > dev + w->def.contact_distance && lc_pair_separation(w, s1, a, b) > dev + w->def.contact_distance);
 }
 
@@ -228,6 +232,7 @@ static int swept_check(lc_world *w, lc_event_crossings *ec, const double *s0, co
 {
     size_t count6 = (size_t)w->count * 6, bytes = count6 * sizeof(double);
     double *own[2], *world_at = NULL;
+    int free_flight = in_parts != NULL;   /* in_parts: a free-flight trial's (lc_trial.min_part) */
     int have_world[LC_SWEEP_SAMPLES] = {0};
     int p, k, i;
     unsigned now = new_stamp(&ec->in_cross, &ec->in_cross_now, &ec->in_cross_rows, w->count), *in_cross;
@@ -249,7 +254,7 @@ static int swept_check(lc_world *w, lc_event_crossings *ec, const double *s0, co
             }
         /* the end-point test already bracketed this pair; if another vertex (a corner meeting a
          * corner) dipped in before that crossing's time, the pair's time of impact finds it */
-        if (have || !may_dip(w, s0, s1, h, a, b)) continue;
+        if (have || !may_dip(w, s0, s1, h, a, b, free_flight)) continue;
         if (!w->is_static[a]) rows[nr++] = a;
         if (!w->is_static[b]) rows[nr++] = b;
         uncoupled = coupled[a] != coupled_now && coupled[b] != coupled_now;
@@ -345,7 +350,7 @@ static int crossings_in_parts(lc_world *w, lc_event_crossings *ec, const lc_tria
         nc = lc_find_crossings(w, prev, cur, a, b, &ec->cross, nc);
         if (nc < 0) return -1;
         nc = drop_stalled_from(ec, stalled, nstalled, before, nc);
-        if (nc == before && may_dip(w, prev, cur, hp, a, b)) {
+        if (nc == before && may_dip(w, prev, cur, hp, a, b, 1)) {
             const double *sp = prev, *sc;
             for (k = 1; k <= LC_SWEEP_SAMPLES && nc == before; ++k) {
                 if (k == LC_SWEEP_SAMPLES) {

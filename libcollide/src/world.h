@@ -424,9 +424,11 @@ void lc_counters_add(lc_counters *total, const lc_counters *last);
 double lc_time_of_impact(lc_world *w, const double *s0, double h, const lc_crossing *c,
                          const int *rows, int nrows, lc_touch *touches, int ntouches, double *scratch);
 /* Time in [0, h] at which bodies a and b, separated by more than the contact gap at s0 and overlapping
- * at s0 + h, are separated by the contact gap again (bisection on their separating-axis distance). */
-double lc_pair_time_of_impact(lc_world *w, const double *s0, double h, int a, int b,
-                              const int *rows, int nrows, lc_touch *touches, int ntouches, double *scratch);
+ * at s0 + h, are separated by the contact gap again (bisection on their separating-axis distance), to
+ * toi_time_tolerance and, beyond it, until they are at most `reach` farther apart than the contact gap
+ * (INFINITY: the time tolerance only). */
+double lc_pair_time_of_impact(lc_world *w, const double *s0, double h, int a, int b, const int *rows, int nrows,
+                              lc_touch *touches, int ntouches, double reach, double *scratch);
 
 /* ---- energy.c ---- */
 void lc_compute_energy(const lc_world *w, const double *state, lc_energy *out);
