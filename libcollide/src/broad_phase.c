@@ -204,7 +204,10 @@ static int order_pairs(lc_world *w, int *p, int count)
 }
 
 /* Body i's box over the interval (both end poses), grown by margin. */
-static void swept_box(lc_world *w, const double *s0, const double *s1, int i, double margin, box *out)
+static void bound_box(const lc_world *w, const double *s0, const double *s1, int i, double margin, box *out);
+
+/* Body i's end poses' boxes, joined and grown by margin. */
+static void end_box(lc_world *w, const double *s0, const double *s1, int i, double margin, box *out)
 {
     box b0, b1;
     body_box(w, s0, i, &b0);
@@ -217,6 +220,17 @@ static void swept_box(lc_world *w, const double *s0, const double *s1, int i, do
     }
     b0.x0 -= margin; b0.y0 -= margin; b0.x1 += margin; b0.y1 += margin;
     *out = b0;
+}
+
+/* Where body i can be between s0 and s1: its end poses' boxes, or, turning farther than a
+ * rotation-limited interval allows (a free-flight step checks a fast spinner's pairs in parts), its
+ * bounding circle's: its corners swing well outside the end boxes between them. */
+static void swept_box(lc_world *w, const double *s0, const double *s1, int i, double margin, box *out)
+{
+    if (s1 != s0 && !w->is_static[i] && fabs(s1[i * 6 + SA] - s0[i * 6 + SA]) > LC_MAX_TRIAL_ROTATION)
+        bound_box(w, s0, s1, i, margin, out);
+    else
+        end_box(w, s0, s1, i, margin, out);
 }
 
 /* Every body's swept box, indexed by row. */
@@ -316,6 +330,16 @@ void lc_swept_box(lc_world *w, const double *s0, const double *s1, int row, doub
 {
     box b;
     swept_box(w, s0, s1, row, margin, &b);
+    out[0] = b.x0;
+    out[1] = b.y0;
+    out[2] = b.x1;
+    out[3] = b.y1;
+}
+
+void lc_end_poses_box(lc_world *w, const double *s0, const double *s1, int row, double margin, double out[4])
+{
+    box b;
+    end_box(w, s0, s1, row, margin, &b);
     out[0] = b.x0;
     out[1] = b.y0;
     out[2] = b.x1;

@@ -21,6 +21,8 @@ struct lc_event_crossings {
     int in_cross_rows;
     lc_buf sample0, sample1;  /* the swept check: an uncoupled pair's states at two sub-times */
     lc_buf samples;           /* and the whole world's at every sub-time */
+    lc_buf part0, part1;      /* a pair tested in parts: its states at two part ends */
+    lc_buf in_parts;          /* 1 for the pairs tested in parts (the swept check leaves them) */
 };
 
 lc_event_crossings *lc_event_crossings_create(void)
@@ -71,6 +73,9 @@ void lc_event_crossings_destroy(lc_event_crossings *ec)
     lc_buf_free(&ec->sample0);
     lc_buf_free(&ec->sample1);
     lc_buf_free(&ec->samples);
+    lc_buf_free(&ec->part0);
+    lc_buf_free(&ec->part1);
+    lc_buf_free(&ec->in_parts);
     free(ec);
 }
 
@@ -87,17 +92,22 @@ static uint32_t vertex_key(const lc_world *w, int a, int vertex, int b)
  * that the contact forces did not hold exactly across the trial interval, crossing its own gap) would
  * stop time at that instant forever. Such a vertex is set aside for the rest of the step (the contact
  * forces and the end-of-step projection hold it), while every other vertex is still checked. */
-static int drop_stalled(lc_event_crossings *ec, const lc_crossing *stalled, int nstalled, int nc)
+static int drop_stalled_from(lc_event_crossings *ec, const lc_crossing *stalled, int nstalled, int from, int nc)
 {
     lc_crossing *c = (lc_crossing *)ec->cross.p;
-    int i, k, kept = 0;
-    for (i = 0; i < nc; ++i) {
+    int i, k, kept = from;
+    for (i = from; i < nc; ++i) {
         int skip = 0;
         for (k = 0; k < nstalled && !skip; ++k)
             skip = stalled[k].a == c[i].a && stalled[k].b == c[i].b && stalled[k].vertex == c[i].vertex;
         if (!skip) c[kept++] = c[i];
     }
     return kept;
+}
+
+static int drop_stalled(lc_event_crossings *ec, const lc_crossing *stalled, int nstalled, int nc)
+{
+    return drop_stalled_from(ec, stalled, nstalled, 0, nc);
 }
 
 /* A vertex held by a resting contact force can sink below its gap by what the force solver left
@@ -147,6 +157,8 @@ static int keep_clean_crossings(lc_event_crossings *ec, const uint8_t *dirty, do
     for (i = 0; i < nc; ++i) {
         if (dirty[c[i].a] || dirty[c[i].b]) continue;
         c[i].t_hi -= tmin;
+        c[i].t_lo = fmax(c[i].t_lo - tmin, 0.0);
+        c[i].clear_to = fmax(c[i].clear_to - tmin, 0.0);
         if (!(c[i].t_hi > 0.0)) continue;
         c[kept++] = c[i];
     }
@@ -171,6 +183,40 @@ static double circle_gap(const lc_world *w, const double *s, int a, int b)
     return hypot(s[a * 6 + SX] - s[b * 6 + SX], s[a * 6 + SY] - s[b * 6 + SY]) - w->shape[a].radius - w->shape[b].radius;
 }
 
+/* 1 if a vertex of a or b may dip into the other and come back out between s0 and s1 (h apart):
+ * the pair ends up closer than its chords can stray. free_flight: nothing rests (lc_trial.min_part). */
+static int may_dip(lc_world *w, const double *s0, const double *s1, double h, int a, int b, int free_flight)
+{
+    double dev = chord_deviation(w, s0, s1, h, a, b), sep0;
+    /* a path that strays from its chord by less than a quarter of the contact gap can dip at most
+     * that far past what the end-point test sees: never into the other body (a settled pile) */
+    if (dev < 0.25 * w->def.contact_gap) return 0;
+    /* bounding circles apart by more than the paths can stray, at both ends: nothing can dip in
+     * (the circles' distance is a lower bound of the bodies' distance, as the separation is) */
+    if (circle_gap(w, s0, a, b) > dev + w->def.contact_distance && circle_gap(w, s1, a, b) > dev + w->def.contact_distance)
+        return 0;
+    if (lc_bounds_gap(w, s0, a, b) > dev + w->def.contact_distance &&
+        lc_bounds_gap(w, s1, a, b) > dev + w->def.contact_distance)
+        return 0;
+    sep0 = lc_pair_separation(w, s0, a, b);
+    /* touching at the start: resting contacts guard the pair. In free flight nothing rests, and a
+     * pair touching there has just had an impact, which resolved only its vertices within
+     * contact_distance of the other body: another vertex of the pair, turning in from farther out,
+     * can dip in and back out within the interval unseen by the end points (a block spun by an
+     * impact at one corner, its next corner passing 2 mm deep). That pair is swept as any other. */
+    if (sep0 < w->def.contact_distance && !free_flight) return 0;
+    return !(sep0 > dev + w->def.contact_distance && lc_pair_separation(w, s1, a, b) > dev + w->def.contact_distance);
+}
+
+/* The pair's moving rows (rows[0..nr)) at time t after s0 into dst; only the pair's two rows of dst are
+ * written (a static one as at s0). */
+static int pair_at(lc_world *w, const double *s0, double t, int a, int b, const int *rows, int nr, double *dst)
+{
+    memcpy(&dst[a * 6], &s0[a * 6], 6 * sizeof(double));
+    memcpy(&dst[b * 6], &s0[b * 6], 6 * sizeof(double));
+    return lc_integrate_rows(w, s0, t, rows, nr, NULL, 0, dst);
+}
+
 /* Vertices that dip into another body and come back out within the interval are invisible to the
  * end-point test. For pairs that end up closer than their chords can stray, the two bodies' motion is
  * sampled at LC_SWEEP_SAMPLES sub-times and every sub-interval is tested; a crossing found there
@@ -182,10 +228,11 @@ static double circle_gap(const lc_world *w, const double *s, int a, int b)
 static int swept_check(lc_world *w, lc_event_crossings *ec, const double *s0, const double *s1, double h,
                        const int *pairs, int np, int nc, const unsigned *coupled, unsigned coupled_now,
                        const int *all_rows, int n_all,
-                       lc_touch *rest, int nrest)
+                       lc_touch *rest, int nrest, const uint8_t *in_parts)
 {
     size_t count6 = (size_t)w->count * 6, bytes = count6 * sizeof(double);
     double *own[2], *world_at = NULL;
+    int free_flight = in_parts != NULL;   /* in_parts: a free-flight trial's (lc_trial.min_part) */
     int have_world[LC_SWEEP_SAMPLES] = {0};
     int p, k, i;
     unsigned now = new_stamp(&ec->in_cross, &ec->in_cross_now, &ec->in_cross_rows, w->count), *in_cross;
@@ -198,8 +245,8 @@ static int swept_check(lc_world *w, lc_event_crossings *ec, const double *s0, co
     own[0] = own[1] = NULL;
     for (p = 0; p < np; ++p) {
         int a = pairs[2 * p], b = pairs[2 * p + 1], rows[2], nr = 0, have = 0, uncoupled;
-        double dev, sep0;
         const double *prev, *cur;
+        if (in_parts != NULL && in_parts[p]) continue;   /* swept part by part */
         if (in_cross[a] == now && in_cross[b] == now)
             for (i = 0; i < nc; ++i) {
                 const lc_crossing *c = &((const lc_crossing *)ec->cross.p)[i];
@@ -207,24 +254,7 @@ static int swept_check(lc_world *w, lc_event_crossings *ec, const double *s0, co
             }
         /* the end-point test already bracketed this pair; if another vertex (a corner meeting a
          * corner) dipped in before that crossing's time, the pair's time of impact finds it */
-        if (have) continue;
-        dev = chord_deviation(w, s0, s1, h, a, b);
-        /* a path that strays from its chord by less than a quarter of the contact gap can dip at most
-         * that far past what the end-point test sees: never into the other body (a settled pile) */
-        if (dev < 0.25 * w->def.contact_gap) continue;
-        /* bounding circles apart by more than the paths can stray, at both ends: nothing can dip in
-         * (the circles' distance is a lower bound of the bodies' distance, as the separation is) */
-        if (circle_gap(w, s0, a, b) > dev + w->def.contact_distance &&
-            circle_gap(w, s1, a, b) > dev + w->def.contact_distance)
-            continue;
-        if (lc_bounds_gap(w, s0, a, b) > dev + w->def.contact_distance &&
-            lc_bounds_gap(w, s1, a, b) > dev + w->def.contact_distance)
-            continue;
-        sep0 = lc_pair_separation(w, s0, a, b);
-        /* touching at the start: resting contacts or impacts already guard the pair */
-        if (sep0 < w->def.contact_distance) continue;
-        if (sep0 > dev + w->def.contact_distance && lc_pair_separation(w, s1, a, b) > dev + w->def.contact_distance)
-            continue;
+        if (have || !may_dip(w, s0, s1, h, a, b, free_flight)) continue;
         if (!w->is_static[a]) rows[nr++] = a;
         if (!w->is_static[b]) rows[nr++] = b;
         uncoupled = coupled[a] != coupled_now && coupled[b] != coupled_now;
@@ -242,10 +272,8 @@ static int swept_check(lc_world *w, lc_event_crossings *ec, const double *s0, co
                     if (!own[0] || !own[1]) return -1;
                 }
                 dst = own[k & 1];   /* prev is the other one (or s0) */
-                /* only the pair's two rows are read (a static one as at s0) */
-                memcpy(&dst[a * 6], &s0[a * 6], 6 * sizeof(double));
-                memcpy(&dst[b * 6], &s0[b * 6], 6 * sizeof(double));
-                if (lc_integrate_rows(w, s0, tk, rows, nr, NULL, 0, dst) != 0) return -1;
+                /* only the pair's two rows are read */
+                if (pair_at(w, s0, tk, a, b, rows, nr, dst) != 0) return -1;
                 cur = dst;
             } else {
                 /* the whole world advanced with its resting contacts, exactly as in the trial */
@@ -276,12 +304,87 @@ static int swept_check(lc_world *w, lc_event_crossings *ec, const double *s0, co
     return nc;
 }
 
+/* Parts a free-flight pair is tested over (tr->min_part > 0): vertex paths are straight lines in the
+ * other body's frame while the bodies turn little, so the pair's faster spin (constant in closed form
+ * without torque) sets its parts, not the fastest spin of the world. */
+static int pair_parts(const lc_world *w, const lc_trial *tr, int a, int b)
+{
+    double spin = 0.0, part;
+    if (!w->is_static[a]) spin = fabs(tr->s0[a * 6 + SW]);
+    if (!w->is_static[b]) spin = fmax(spin, fabs(tr->s0[b * 6 + SW]));
+    if (!(spin * tr->h > LC_MAX_TRIAL_ROTATION)) return 1;
+    /* an absurd spin must not split the interval without end (the check is then coarser for it) */
+    part = fmax(LC_MAX_TRIAL_ROTATION / spin, tr->min_part);
+    return (int)fmin(ceil(tr->h / part), ceil(tr->h / tr->min_part));
+}
+
+/* The crossings of the free-flight pair (a, b) over m equal parts of the interval, each part tested as
+ * a rotation-limited interval of its own (end points, then the swept check) and its crossings
+ * bracketed within it. Every part is tested: the search of a part's crossing may find no impact (a
+ * grazing vertex), and a later part's must then be there. The pair moves on its own (nothing couples
+ * it in free flight), so its parts' states are its two rows advanced from s0. Returns the new count,
+ * or -1 without memory. */
+static int crossings_in_parts(lc_world *w, lc_event_crossings *ec, const lc_trial *tr, int a, int b, int m,
+                              const lc_crossing *stalled, int nstalled, int nc)
+{
+    size_t bytes = (size_t)w->count * 6 * sizeof(double);
+    double *part[2], *sample[2];
+    const double *prev = tr->s0, *cur;
+    int rows[2], nr = 0, j, k, i;
+    part[0] = lc_buf_get(&ec->part0, bytes);
+    part[1] = lc_buf_get(&ec->part1, bytes);
+    sample[0] = lc_buf_get(&ec->sample0, bytes);
+    sample[1] = lc_buf_get(&ec->sample1, bytes);
+    if (!part[0] || !part[1] || !sample[0] || !sample[1]) return -1;
+    if (!w->is_static[a]) rows[nr++] = a;
+    if (!w->is_static[b]) rows[nr++] = b;
+    for (j = 1; j <= m; ++j) {
+        double t0 = tr->h * (j - 1) / m, t1 = j == m ? tr->h : tr->h * j / m, hp = t1 - t0;
+        int before = nc;
+        if (j == m) {
+            cur = tr->s1;
+        } else {
+            if (pair_at(w, tr->s0, t1, a, b, rows, nr, part[j & 1]) != 0) return -1;   /* prev: the other one */
+            cur = part[j & 1];
+        }
+        nc = lc_find_crossings(w, prev, cur, a, b, &ec->cross, nc);
+        if (nc < 0) return -1;
+        nc = drop_stalled_from(ec, stalled, nstalled, before, nc);
+        if (nc == before && may_dip(w, prev, cur, hp, a, b, 1)) {
+            const double *sp = prev, *sc;
+            for (k = 1; k <= LC_SWEEP_SAMPLES && nc == before; ++k) {
+                if (k == LC_SWEEP_SAMPLES) {
+                    sc = cur;
+                } else {
+                    if (pair_at(w, tr->s0, t0 + hp * k / LC_SWEEP_SAMPLES, a, b, rows, nr, sample[k & 1]) != 0)
+                        return -1;
+                    sc = sample[k & 1];
+                }
+                nc = lc_find_crossings(w, sp, sc, a, b, &ec->cross, nc);
+                if (nc < 0) return -1;
+                nc = drop_stalled_from(ec, stalled, nstalled, before, nc);
+                if (nc > before) t1 = k == LC_SWEEP_SAMPLES ? t1 : t0 + hp * k / LC_SWEEP_SAMPLES;
+                sp = sc;
+            }
+        }
+        if (nc > before) {
+            for (i = before; i < nc; ++i) {
+                ((lc_crossing *)ec->cross.p)[i].t_lo = t0;
+                ((lc_crossing *)ec->cross.p)[i].t_hi = t1;
+            }
+        }
+        prev = cur;
+    }
+    return nc;
+}
+
 int lc_event_crossings_find(lc_world *w, lc_event_crossings *ec, const lc_trial *tr, const lc_moved *moved,
                             const lc_crossing *stalled, int nstalled, lc_crossing **out)
 {
-    int np, nc = 0, nkept = 0, i;
+    int np, nc = 0, nkept = 0, i, nstalled_kept = nstalled < LC_MAX_STALLED ? nstalled : LC_MAX_STALLED;
     unsigned *coupled;
     const int *pairs;
+    uint8_t *in_parts = NULL;
     if (moved != NULL) {
         nc = nkept = keep_clean_crossings(ec, moved->marked, moved->since);
         np = lc_broad_phase_of(w, tr->s0, tr->s1, w->def.contact_distance, moved->marked, moved->rows, moved->n,
@@ -291,12 +394,25 @@ int lc_event_crossings_find(lc_world *w, lc_event_crossings *ec, const lc_trial 
     }
     if (np < 0) return -1;
     pairs = (const int *)ec->pairs.p;
+    if (tr->min_part > 0.0) {
+        in_parts = lc_buf_get(&ec->in_parts, (size_t)(np > 0 ? np : 1));
+        if (in_parts == NULL) return -1;
+        memset(in_parts, 0, (size_t)np);
+    }
     for (i = 0; i < np && nstalled <= LC_MAX_STALLED; ++i) {
-        nc = lc_find_crossings(w, tr->s0, tr->s1, pairs[2 * i], pairs[2 * i + 1], &ec->cross, nc);
+        int a = pairs[2 * i], b = pairs[2 * i + 1], before = nc, k, m = in_parts ? pair_parts(w, tr, a, b) : 1;
+        if (m > 1) {
+            in_parts[i] = 1;
+            nc = crossings_in_parts(w, ec, tr, a, b, m, stalled, nstalled_kept, nc);
+            if (nc < 0) return -1;
+            continue;
+        }
+        nc = lc_find_crossings(w, tr->s0, tr->s1, a, b, &ec->cross, nc);
         if (nc < 0) return -1;
+        for (k = before; k < nc; ++k) ((lc_crossing *)ec->cross.p)[k].t_hi = tr->h;
     }
     /* past LC_MAX_STALLED the list is full (and no crossing is looked for): only its entries */
-    nc = drop_stalled(ec, stalled, nstalled < LC_MAX_STALLED ? nstalled : LC_MAX_STALLED, nc);
+    nc = drop_stalled(ec, stalled, nstalled_kept, nc);
     nc = drop_resting_drift(w, ec, tr->rest, tr->nrest, tr->s1, nc);
     if (nc < 0) return -1;
     /* a body touching nothing and tied by no spring (nor force callback) to another body moves on its
@@ -304,9 +420,8 @@ int lc_event_crossings_find(lc_world *w, lc_event_crossings *ec, const lc_trial 
     if (new_stamp(&ec->coupled, &ec->coupled_now, &ec->coupled_rows, w->count) == 0) return -1;
     coupled = (unsigned *)ec->coupled.p;
     mark_coupled(w, coupled, tr, ec->coupled_now);
-    for (i = nkept; i < nc; ++i) ((lc_crossing *)ec->cross.p)[i].t_hi = tr->h;
     nc = swept_check(w, ec, tr->s0, tr->s1, tr->h, pairs, np, nc, coupled, ec->coupled_now, tr->rows, tr->nrows,
-                     tr->rest, tr->nrest);
+                     tr->rest, tr->nrest, in_parts);
     if (nc < 0) return -1;
     *out = (lc_crossing *)ec->cross.p;
     ec->count = nc;

@@ -18,6 +18,12 @@ typedef struct lc_trial {
     int nrows;
     lc_touch *rest;
     int nrest;
+    /* > 0 in free flight (no resting touch, no tie between bodies, every row in closed form without
+     * torque): h is not cut by the fastest spin of the world; a pair whose faster body turns more than
+     * LC_MAX_TRIAL_ROTATION over h is tested over equal parts of it in which that body turns at most
+     * that much, none shorter than min_part (its crossings bracketed within their part). 0: every
+     * pair over the whole interval (h already rotation-limited). */
+    double min_part;
 } lc_trial;
 
 /* The bodies the last impact moved (marked[row] != 0 for rows[0..n)), `since` s before the interval. */

@@ -29,7 +29,9 @@ struct lc_event_regime {
     lc_buf state0, state1, scratch;  /* a pass's start and trial end, and integration scratch (count x 6) */
     lc_buf rows, moved, moved_rows;  /* the advanced rows; the bodies the last impact moved */
     lc_buf marks, at_best;           /* the energy check's marks; the best time of impact's state */
-    lc_buf clock;                    /* lazy clocks: the time (from the pass's t0) each row's state is at */
+    lc_buf at_lo;                    /* a crossing's rows at the start of its bracket */
+    lc_buf clock;                    /* lazy clocks: the time (from the pass's t0) each row's state is at, and its anchor's */
+    lc_buf anchor;                   /* lazy clocks: each row's state at its last event */
     lc_buf in_rows;                  /* 1 for the advanced rows (spin_max) */
 };
 
@@ -63,7 +65,9 @@ void lc_event_regime_destroy(lc_event_regime *er)
     lc_buf_free(&er->moved_rows);
     lc_buf_free(&er->marks);
     lc_buf_free(&er->at_best);
+    lc_buf_free(&er->at_lo);
     lc_buf_free(&er->clock);
+    lc_buf_free(&er->anchor);
     lc_buf_free(&er->in_rows);
     free(er);
 }
@@ -84,23 +88,39 @@ static int rows_closed_form(const lc_world *w, const int *rows, int nrows)
 
 /* Lazy clocks (free flight while the broad phase tracks the trial): an impact advances only the bodies
  * it involves and the ones it looks at to its time; every other body stays where its last event left
- * it, at clock[row], until something near it looks at it or the trial ends. w->state and s0 hold each
- * row at its clock (the impact's rows are copied from w->state to s0 at the next pass's start). */
+ * it until something near it looks at it or the trial ends. w->state and s0 hold each row at
+ * clock[row] (the impact's rows are copied from w->state to s0 at the next pass's start). A row is
+ * brought to a time in one closed-form advance from its anchor, the state its last event (an impact,
+ * or the trial's start) left it in at anchor_t[row]: so its state at any time is the same bits however
+ * often, and after whichever other bodies' events, it was looked at. */
 typedef struct lazy_clock {
     lc_world *w;
-    double *s0, *clock;
+    double *s0, *clock, *anchor, *anchor_t;
     double now;   /* the time the rows looked at are brought to */
 } lazy_clock;
+
+/* Row r of w->state at time t, from its anchor. */
+static int row_at(lazy_clock *lz, int r, double t)
+{
+    return lc_integrate_rows(lz->w, lz->anchor, t - lz->anchor_t[r], &r, 1, NULL, 0, lz->w->state);
+}
+
+/* The rows' states in w->state are their new anchors, at time t. */
+static void anchor_rows(lazy_clock *lz, const int *rows, int n, double t)
+{
+    int i;
+    for (i = 0; i < n; ++i) {
+        memcpy(&lz->anchor[rows[i] * 6], &lz->w->state[rows[i] * 6], 6 * sizeof(double));
+        lz->anchor_t[rows[i]] = t;
+    }
+}
 
 static int sync_row(void *ctx, int r)
 {
     lazy_clock *lz = ctx;
     lc_world *w = lz->w;
-    double h;
     if (w->is_static[r] || lz->clock[r] == lz->now) return 0;
-    h = lz->now - lz->clock[r];
-    /* closed form in place: each row's positions are written from its velocities before those */
-    if (lc_integrate_rows(w, w->state, h, &r, 1, NULL, 0, w->state) != 0) return -1;
+    if (row_at(lz, r, lz->now) != 0) return -1;
     memcpy(&lz->s0[r * 6], &w->state[r * 6], 6 * sizeof(double));
     lz->clock[r] = lz->now;
     return 0;
@@ -152,6 +172,73 @@ static void copy_row_spin(double *s0, const double *state, int r, spin_max *m)
     memcpy(&s0[r * 6], &state[r * 6], 6 * sizeof(double));
 }
 
+/* The time of impact of crossing c within [c->t_lo, h] from s0, advancing the rows erows[0..nerows)
+ * with the touches erest[0..nerest) (lc_time_of_impact), or -1. A crossing bracketed within a part of
+ * the interval (event_crossings.h) is searched from the part's start, where its vertex is outside
+ * (at_lo: a world-sized buffer for the rows there). */
+static double crossing_toi(lc_world *w, const double *s0, const lc_crossing *c, double h, const int *erows, int nerows,
+                           lc_touch *erest, int nerest, double *at_lo, double *scratch)
+{
+    double lo = c->t_lo, tau;
+    if (!(lo > 0.0)) return lc_time_of_impact(w, s0, h, c, erows, nerows, erest, nerest, scratch);
+    if (!(lo < h)) return -1.0;
+    memcpy(&at_lo[c->a * 6], &s0[c->a * 6], 6 * sizeof(double));
+    memcpy(&at_lo[c->b * 6], &s0[c->b * 6], 6 * sizeof(double));
+    if (lc_integrate_rows(w, s0, lo, erows, nerows, erest, nerest, at_lo) != 0) return -1.0;
+    tau = lc_time_of_impact(w, at_lo, h - lo, c, erows, nerows, erest, nerest, scratch);
+    return tau < 0.0 ? tau : lo + tau;
+}
+
+/* A vertex's time of impact is where it meets its edge's line at the contact gap. Over a long bracket
+ * (a search of a whole part of the step, kept for the rest of the interval) that time is checked
+ * against the pair's separation there, as the pass start's impact is (event_advance):
+ *  - the pair apart there (by more than contact_distance): while the bodies turn, the vertex met the
+ *    line beside the edge; an impulse there would act at no contact and make energy. The time is the
+ *    pair's first touch after tau within the bracket, or none if it does not touch by its end;
+ *  - another vertex of the pair already inside (corner against corner): the pair met earlier, at its
+ *    first touch after the bracket's start.
+ * Either is found by bisection on the pair's separation (continuous, negative exactly when the two
+ * overlap; c->by_pair set). Returns the time, -1 for none, -2 without memory. */
+static double check_touch(lc_world *w, const double *s0, lc_crossing *c, double tau, const int *erows, int nerows,
+                          lc_touch *erest, int nerest, double *at, double *scratch)
+{
+    double sep, lo = c->t_lo, t2;
+    memcpy(&at[c->a * 6], &s0[c->a * 6], 6 * sizeof(double));
+    memcpy(&at[c->b * 6], &s0[c->b * 6], 6 * sizeof(double));
+    if (lc_integrate_rows(w, s0, tau, erows, nerows, erest, nerest, at) != 0) return -2.0;
+    sep = lc_pair_separation(w, at, c->a, c->b);
+    if (sep > w->def.contact_distance) {
+        /* the pair at the bracket's end: apart there, it has no touch to find */
+        memcpy(&scratch[c->a * 6], &s0[c->a * 6], 6 * sizeof(double));
+        memcpy(&scratch[c->b * 6], &s0[c->b * 6], 6 * sizeof(double));
+        if (lc_integrate_rows(w, s0, c->t_hi, erows, nerows, erest, nerest, scratch) != 0) return -2.0;
+        if (!(lc_pair_separation(w, scratch, c->a, c->b) < w->def.contact_gap)) return -1.0;
+        lo = tau;
+    } else if (sep < -0.5 * w->def.contact_gap) {
+        /* the pair at the bracket's start */
+        memcpy(&at[c->a * 6], &s0[c->a * 6], 6 * sizeof(double));
+        memcpy(&at[c->b * 6], &s0[c->b * 6], 6 * sizeof(double));
+        if (lo > 0.0 && lc_integrate_rows(w, s0, lo, erows, nerows, erest, nerest, at) != 0) return -2.0;
+        if (!(lc_pair_separation(w, at, c->a, c->b) > w->def.contact_gap)) return tau;   /* touching there already */
+    } else {
+        return tau;
+    }
+    /* The impact at the answer resolves the pair's touches closer than contact_distance
+     * (lc_event_impact_group): the time tolerance alone leaves the pair up to |v| tol apart (2.7e-5 m
+     * at 27 m/s and 1e-6 s, beyond the 1e-5 m of contact_distance), where nothing is applied, and a
+     * search from that nearer start would return the start itself again (the vertex then set aside as
+     * stalled, and passing into the other body). So the bisection goes on until the pair is within
+     * half the band between contact_gap and contact_distance (the round-off between the search's state
+     * and the impact's stays far inside the other half); at the default 1e-10 s the time tolerance
+     * alone gives that below 5e4 m/s. Free flight moves in closed form: its separation is continuous
+     * and each halving brings it closer. */
+    t2 = lc_pair_time_of_impact(w, at, (sep > 0.0 ? c->t_hi : tau) - lo, c->a, c->b, erows, nerows, erest, nerest,
+                                0.5 * (w->def.contact_distance - w->def.contact_gap), scratch);
+    if (t2 < 0.0) return -1.0;
+    c->by_pair = 1;
+    return lo + t2;
+}
+
 static lc_status event_advance(lc_world *w, lc_event_regime *er, const lc_step_try *step, double dt, double t0,
                                const int *event_rows, int nrows, int *marks_known, int *handover, double *t_handover);
 
@@ -167,11 +254,11 @@ static lc_status event_advance(lc_world *w, lc_event_regime *er, const lc_step_t
                                const int *event_rows, int nrows, int *marks_known, int *handover, double *t_handover)
 {
     size_t bytes;
-    double *s0, *s1, *scratch, remaining;
+    double *s0, *s1, *scratch, *at_lo, remaining, now_t = 0.0;
     int *rows, i, events = 0, nstalled = 0, nrest = 0, passes = 0, persisting = -1, last_impact_body = -1;
     int dissipative_events = 0;
     int *drows, ndirty = 0, local_next = 0, body_springs = 0, started_deep = 0, islands_alone = 0;
-    int tracked = 0, may_track = 0, lazy = 0, fresh[2] = {-1, -1};
+    int tracked = 0, may_track = 0, lazy = 0, fresh[2] = {-1, -1}, closed_form = -1;
     lazy_clock lz;
     spin_max spin;
     uint8_t *dirty, *in_rows;
@@ -184,8 +271,9 @@ static lc_status event_advance(lc_world *w, lc_event_regime *er, const lc_step_t
     s0 = lc_buf_get(&er->state0, bytes);
     s1 = lc_buf_get(&er->state1, bytes);
     scratch = lc_buf_get(&er->scratch, bytes);
+    at_lo = lc_buf_get(&er->at_lo, bytes);
     rows = lc_buf_get(&er->rows, (size_t)(w->count > 0 ? w->count : 1) * sizeof(int));
-    if (!s0 || !s1 || !scratch || !rows) return lc_fail(w, LC_ERR_NO_MEMORY, "out of memory in step");
+    if (!s0 || !s1 || !scratch || !at_lo || !rows) return lc_fail(w, LC_ERR_NO_MEMORY, "out of memory in step");
     memcpy(rows, event_rows, (size_t)nrows * sizeof(int));
     dirty = lc_buf_get(&er->moved, (size_t)w->count);
     drows = lc_buf_get(&er->moved_rows, (size_t)w->count * sizeof(int));
@@ -200,9 +288,11 @@ static lc_status event_advance(lc_world *w, lc_event_regime *er, const lc_step_t
     spin.in_rows = in_rows;
     lz.w = w;
     lz.s0 = s0;
-    lz.clock = lc_buf_get(&er->clock, (size_t)(w->count > 0 ? w->count : 1) * sizeof(double));
+    lz.clock = lc_buf_get(&er->clock, (size_t)(w->count > 0 ? w->count : 1) * 2 * sizeof(double));
+    lz.anchor = lc_buf_get(&er->anchor, bytes);
     lz.now = 0.0;
-    if (lz.clock == NULL) return lc_fail(w, LC_ERR_NO_MEMORY, "out of memory in step");
+    if (lz.clock == NULL || lz.anchor == NULL) return lc_fail(w, LC_ERR_NO_MEMORY, "out of memory in step");
+    lz.anchor_t = lz.clock + (w->count > 0 ? w->count : 1);
     for (i = 0; i < w->spring_count; ++i)
         if (w->springs[i].def.body_b != LC_WORLD_ANCHOR) body_springs = 1;
     /* the force callback may tie any body to any other, as a spring between bodies does */
@@ -210,20 +300,22 @@ static lc_status event_advance(lc_world *w, lc_event_regime *er, const lc_step_t
 
     remaining = dt;
     while (remaining > 0.0) {
-        int nc, best = -1, nimp, hits, by_pair = 0, adv[2], adv_n = 0;
-        double tmin = remaining;
+        int nc, best = -1, nimp, hits, by_pair = 0, adv[2], adv_n = 0, at_t_best, best_searched = 1;
+        double tmin = remaining, t_best = 0.0;
         lc_crossing *cross;
         lc_touch *impact;
 
         double trial = remaining, wmax = 0.0;
-        int events_before = events, local = 0, can_reuse;
+        int events_before = events, local = 0, can_reuse, free_flight;
         /* after an impact in free flight only the impact's bodies can have come to touch anything:
          * every other pair was apart (nothing rested) and moved without an impact */
         ts = lc_stage_begin(w);
-        lz.now = dt - remaining;
+        lz.now = now_t;
         if (lazy) {
-            /* the impact's rows to s0, and what the resting search below looks at to now */
+            /* the impact's rows to s0 and to their anchors, and what the resting search below looks at
+             * to now */
             for (i = 0; i < ndirty; ++i) copy_row_spin(s0, w->state, drows[i], &spin);
+            anchor_rows(&lz, drows, ndirty, lz.now);
             for (i = 0; i < 2; ++i)
                 if (fresh[i] >= 0) copy_row_spin(s0, w->state, fresh[i], &spin);
             if (sync_near(&lz, w->state, w->state, drows, ndirty, w->def.contact_distance) != 0) goto oom;
@@ -259,18 +351,27 @@ static lc_status event_advance(lc_world *w, lc_event_regime *er, const lc_step_t
         }
         if (!lazy) memcpy(s0, w->state, (size_t)w->count * 6 * sizeof(double));
         /* Vertex paths are tested as straight lines in the other body's frame; that holds while bodies
-         * turn little, so a fast spinner is checked over shorter trial intervals. */
-        if (lazy && spin.known) {
-            wmax = spin.w;
-        } else {
-            for (i = 0; i < nrows; ++i) wmax = fmax(wmax, fabs(s0[rows[i] * 6 + SW]));
-            spin.w = wmax;
-            spin.known = 1;
+         * turn little, so a fast spinner is checked over shorter intervals. In free flight every pair
+         * moves on its own and is checked in parts set by its own spin (event_crossings.h): the trial
+         * runs to the step's end, and a body no impact reaches gets there in one closed-form advance.
+         * Otherwise (resting touches, ties between bodies, forces that change along the path) the
+         * fastest spin of the world cuts the trial. */
+        /* every row's forces are the same through the step: looked at once, when first needed */
+        if (closed_form < 0 && nrest == 0 && !body_springs) closed_form = rows_closed_form(w, rows, nrows);
+        free_flight = closed_form == 1 && nrest == 0 && !body_springs;
+        if (!free_flight) {
+            if (lazy && spin.known) {
+                wmax = spin.w;
+            } else {
+                for (i = 0; i < nrows; ++i) wmax = fmax(wmax, fabs(s0[rows[i] * 6 + SW]));
+                spin.w = wmax;
+                spin.known = 1;
+            }
+            if (wmax * trial > LC_MAX_TRIAL_ROTATION) trial = LC_MAX_TRIAL_ROTATION / wmax;
+            /* an absurd spin must not split the step without end: at most LC_MAX_TRIALS rotation-limited
+             * intervals (the check is then coarser for that body) */
+            if (trial < dt / LC_MAX_TRIALS) trial = fmin(remaining, dt / LC_MAX_TRIALS);
         }
-        if (wmax * trial > LC_MAX_TRIAL_ROTATION) trial = LC_MAX_TRIAL_ROTATION / wmax;
-        /* an absurd spin must not split the step without end: at most LC_MAX_TRIALS rotation-limited
-         * intervals (the check is then coarser for that body) */
-        if (trial < dt / LC_MAX_TRIALS) trial = fmin(remaining, dt / LC_MAX_TRIALS);
         /* the rest of the previous trial, if the turning limit allows it: then its end is the same */
         can_reuse = local_next && trial_left > 0.0 && trial_left <= trial;
         if (lazy && !can_reuse) {
@@ -314,25 +415,17 @@ static lc_status event_advance(lc_world *w, lc_event_regime *er, const lc_step_t
                     return lc_step_undo(w, step, LC_ERR_NUMERIC,
                                         "integration produced a non-finite state (forces too stiff for dt?)");
         }
-        /* A trial interval's first impact is followed by local passes (above): from the first of them on,
-         * where every body can be until the interval ends is tracked in a grid, and each impact's bodies
-         * only are moved in it; their pairs and impact groups are then found among what is near them,
-         * not among every body. Free flight only: a body in closed form stays on its path. */
+        /* A trial interval's first impact is followed by local passes (above): from that impact on,
+         * where every body can be until the interval ends is tracked in a grid (below), and each
+         * impact's bodies only are moved in it; their pairs and impact groups are then found among what
+         * is near them, not among every body. Free flight only: a body in closed form stays on its
+         * path. */
         if (!local) {
             lc_broad_phase_untrack(w);
             tracked = 0;
-            may_track = nrest == 0 && !body_springs && nrows >= LC_TRACK_MIN_ROWS;
+            may_track = free_flight && nrows >= LC_TRACK_MIN_ROWS;
         } else if (tracked) {
             if (lc_broad_phase_retrack(w, s0, s1, trial, drows, ndirty, w->def.contact_distance) != 0) goto oom;
-        } else if (may_track) {
-            may_track = 0;
-            if (rows_closed_form(w, rows, nrows)) {
-                if (lc_broad_phase_track(w, s0, s1, trial, rows, nrows, w->def.contact_distance) != 0) goto oom;
-                tracked = 1;
-                /* every row is at now: from here on each keeps its own clock */
-                lazy = 1;
-                for (i = 0; i < nrows; ++i) lz.clock[rows[i]] = lz.now;
-            }
         }
         /* what this pass's pairs look at (the bodies near the impact's), to now */
         if (lazy && sync_near(&lz, s0, s1, drows, ndirty, w->def.contact_distance) != 0) goto oom;
@@ -358,6 +451,7 @@ static lc_status event_advance(lc_world *w, lc_event_regime *er, const lc_step_t
             tr.nrows = nrows;
             tr.rest = rest;
             tr.nrest = nrest;
+            tr.min_part = free_flight ? dt / LC_MAX_TRIALS : 0.0;
             moved.marked = dirty;
             moved.rows = drows;
             moved.n = ndirty;
@@ -366,14 +460,14 @@ static lc_status event_advance(lc_world *w, lc_event_regime *er, const lc_step_t
             nc = lc_event_crossings_find(w, er->crossings, &tr, local ? &moved : NULL, stalled, nstalled, &cross);
             lc_stage_end(w, &w->last.time_detection, ts);
             if (nc < 0) goto oom;
-            /* the kept crossings' bodies to now, for their time-of-impact searches from s0 */
-            for (i = 0; i < nc && lazy; ++i)
-                if (sync_row(&lz, cross[i].a) != 0 || sync_row(&lz, cross[i].b) != 0) goto oom;
         }
-        /* earliest time of impact; a crossing whose gap is still open at the best time so far is later.
-         * Each evaluation advances only the islands of the crossing's two bodies; those islands at
-         * the best time so far are kept for the next crossing of the same islands (a pile is one
-         * island, and each of its integrations solves the whole pile's contact forces). */
+        /* earliest time of impact. Each evaluation advances only the islands of the crossing's two bodies.
+         * In free flight every crossing's search is its own: over its whole bracket, once, its result
+         * kept while its bodies keep their paths (an impact costs the searches of the crossings it
+         * makes, not of every crossing pending in the interval). Otherwise a crossing whose gap is
+         * still open at the best time so far is later; those islands at the best time so far are kept
+         * for the next crossing of the same islands (a pile is one island, and each of its
+         * integrations solves the whole pile's contact forces). */
         ts = lc_stage_begin(w);
         /* a local pass has no resting touch and no spring between bodies: the islands of the last build
          * without touches are still every row on its own */
@@ -388,6 +482,30 @@ static lc_status event_advance(lc_world *w, lc_event_regime *er, const lc_step_t
                 const int *erows;
                 int nerows, nerest;
                 lc_touch *erest;
+                if (free_flight) {
+                    int searched = 0;   /* from this pass's start */
+                    if (cross[i].toi < 0.0 && cross[i].clear_to < cross[i].t_hi) {
+                        /* its bodies to now, for its search from s0 */
+                        if (lazy && (sync_row(&lz, cross[i].a) != 0 || sync_row(&lz, cross[i].b) != 0)) goto oom;
+                        if (lc_touch_islands_of(er->islands, cross[i].a, cross[i].b, &erows, &nerows, &erest, &nerest) != 0)
+                            goto oom;
+                        tau = crossing_toi(w, s0, &cross[i], cross[i].t_hi, erows, nerows, erest, nerest, at_lo, scratch);
+                        if (tau >= 0.0) {
+                            tau = check_touch(w, s0, &cross[i], tau, erows, nerows, erest, nerest, at_lo, scratch);
+                            if (tau < -1.5) goto oom;
+                        }
+                        if (tau < 0.0) cross[i].clear_to = cross[i].t_hi;
+                        else cross[i].toi = lz.now + tau;
+                        searched = 1;
+                    }
+                    if (cross[i].toi >= 0.0 && (best < 0 || cross[i].toi < t_best)) {
+                        t_best = cross[i].toi;
+                        tmin = fmax(t_best - lz.now, 0.0);
+                        best = i;
+                        best_searched = searched;
+                    }
+                    continue;
+                }
                 if (lc_touch_islands_of(er->islands, cross[i].a, cross[i].b, &erows, &nerows, &erest, &nerest) != 0) goto oom;
                 if (best >= 0) {
                     double g;
@@ -406,12 +524,14 @@ static lc_status event_advance(lc_world *w, lc_event_regime *er, const lc_step_t
                     g = lc_vertex_edge_gap(w, at_best, cross[i].a, cross[i].vertex, cross[i].b, cross[i].edge);
                     if (g > w->def.contact_gap) continue;
                 }
-                tau = lc_time_of_impact(w, s0, fmin(tmin, cross[i].t_hi), &cross[i], erows, nerows, erest, nerest,
-                                        scratch);
+                tau = crossing_toi(w, s0, &cross[i], fmin(tmin, cross[i].t_hi), erows, nerows, erest, nerest, at_lo,
+                                   scratch);
                 if (tau < 0.0) continue;
                 if (best < 0 || tau < tmin) { tmin = tau; best = i; }
             }
         }
+        /* the impact's bodies to now (a time of impact kept from the last pass did not look at them) */
+        if (best >= 0 && lazy && (sync_row(&lz, cross[best].a) != 0 || sync_row(&lz, cross[best].b) != 0)) goto oom;
         lc_stage_end(w, &w->last.time_toi_search, ts);
         if (best < 0) {
             local_next = 0;
@@ -419,10 +539,21 @@ static lc_status event_advance(lc_world *w, lc_event_regime *er, const lc_step_t
             memcpy(w->state, s1, (size_t)w->count * 6 * sizeof(double));
             remaining -= trial;
             if (remaining < 1e-14 * dt) remaining = 0.0;
+            now_t = dt - remaining;
             w->time = t0 + (dt - remaining);
             continue;
         }
 
+        if (may_track) {
+            /* the interval's first impact: where every body can be until the interval ends is tracked
+             * from here on, and every row, at now, keeps its own clock */
+            may_track = 0;
+            if (lc_broad_phase_track(w, s0, s1, trial, rows, nrows, w->def.contact_distance) != 0) goto oom;
+            tracked = 1;
+            lazy = 1;
+            memcpy(lz.anchor, s0, (size_t)w->count * 6 * sizeof(double));
+            for (i = 0; i < nrows; ++i) lz.clock[rows[i]] = lz.anchor_t[rows[i]] = lz.now;
+        }
         ts = lc_stage_begin(w);
         /* lazy clocks: only the crossing's two bodies go to the impact's time here (the others it acts
          * on are brought there as the impact group finds them) */
@@ -431,10 +562,18 @@ static lc_status event_advance(lc_world *w, lc_event_regime *er, const lc_step_t
             if (!w->is_static[cross[best].a]) adv[adv_n++] = cross[best].a;
             if (!w->is_static[cross[best].b]) adv[adv_n++] = cross[best].b;
         }
+        by_pair = cross[best].by_pair;
+        at_t_best = 0;
         if (tmin > 0.0) {
             int ba = cross[best].a, bb = cross[best].b;
-            if (lc_integrate_rows(w, s0, tmin, lazy ? adv : rows, lazy ? adv_n : nrows, rest, nrest, w->state) != 0)
+            if (lazy && free_flight && t_best >= 0.0) {
+                /* from their anchors, as every lazy row (below) */
+                for (i = 0; i < adv_n; ++i)
+                    if (row_at(&lz, adv[i], t_best) != 0) goto oom;
+                at_t_best = 1;
+            } else if (lc_integrate_rows(w, s0, tmin, lazy ? adv : rows, lazy ? adv_n : nrows, rest, nrest, w->state) != 0) {
                 goto oom;
+            }
             /* another vertex of the pair (corner against corner) already inside, deeper than any
              * crossing test can see from here on: the pair met earlier, find when */
             if (lc_pair_separation(w, w->state, ba, bb) < -0.5 * w->def.contact_gap &&
@@ -446,11 +585,13 @@ static lc_status event_advance(lc_world *w, lc_event_regime *er, const lc_step_t
                 if (lc_touch_islands_of(er->islands, ba, bb, &erows, &nerows, &erest, &nerest) != 0) goto oom;
                 lc_stage_end(w, &w->last.time_integration, ts);
                 ts = lc_stage_begin(w);
-                t2 = lc_pair_time_of_impact(w, s0, tmin, ba, bb, erows, nerows, erest, nerest, scratch);
+                t2 = lc_pair_time_of_impact(w, s0, tmin, ba, bb, erows, nerows, erest, nerest, INFINITY, scratch);
                 lc_stage_end(w, &w->last.time_toi_search, ts);
                 ts = lc_stage_begin(w);
                 if (t2 < 0.0) goto oom;
                 tmin = t2;
+                t_best = -1.0;   /* the time from this pass's start */
+                at_t_best = 0;
                 by_pair = 1;
                 if (lc_integrate_rows(w, s0, tmin, lazy ? adv : rows, lazy ? adv_n : nrows, rest, nrest, w->state) != 0)
                     goto oom;
@@ -459,12 +600,24 @@ static lc_status event_advance(lc_world *w, lc_event_regime *er, const lc_step_t
             memcpy(w->state, s0, (size_t)w->count * 6 * sizeof(double));
         }
         lc_stage_end(w, &w->last.time_integration, ts);
-        remaining -= tmin;
-        w->time = t0 + (dt - remaining);
+        /* in free flight the impact's time is its crossing's, kept from the step's start: the same bits
+         * whichever other impacts came between (not a sum of their intervals) */
+        if (free_flight && t_best >= 0.0) {
+            remaining = dt - t_best;
+            w->time = t0 + t_best;
+        } else {
+            remaining -= tmin;
+            w->time = t0 + (dt - remaining);
+        }
         if (remaining < 1e-14 * dt) remaining = 0.0;
+        now_t = free_flight && t_best >= 0.0 && remaining > 0.0 ? t_best : dt - remaining;
 
-        lz.now = dt - remaining;
-        for (i = 0; i < adv_n; ++i) lz.clock[adv[i]] = lz.now;
+        lz.now = now_t;
+        for (i = 0; i < adv_n; ++i) {
+            /* the crossing's two bodies at the impact's time from their anchors, unless they are */
+            if (!(at_t_best && now_t == t_best) && lz.clock[adv[i]] != now_t && row_at(&lz, adv[i], now_t) != 0) goto oom;
+            lz.clock[adv[i]] = now_t;
+        }
         fresh[0] = adv_n > 0 ? adv[0] : -1;
         fresh[1] = adv_n > 1 ? adv[1] : -1;
         ts = lc_stage_begin(w);
@@ -504,10 +657,18 @@ static lc_status event_advance(lc_world *w, lc_event_regime *er, const lc_step_t
                     if (!w->is_static[ab[q]] && !dirty[ab[q]]) { dirty[ab[q]] = 1; drows[ndirty++] = ab[q]; }
             }
             local_next = nrest == 0;
-            trial_left = trial - tmin;
+            /* free flight: the trial ends with the step */
+            trial_left = free_flight ? remaining : trial - tmin;
             last_tmin = tmin;
         }
-        if (hits == 0 && tmin == 0.0) {
+        if (hits == 0 && free_flight && !best_searched) {
+            /* A time kept from an earlier search applied nothing (its vertex farther than
+             * contact_distance there, or no touch of the pair approaching): that is not yet a stalled
+             * vertex. It is searched again from here, as every crossing is in the other path; only a
+             * search from here that applies nothing at once sets it aside. */
+            cross[best].toi = -1.0;
+            cross[best].clear_to = 0.0;
+        } else if (hits == 0 && tmin == 0.0) {
             if (nstalled < LC_MAX_STALLED) stalled[nstalled] = cross[best];
             nstalled++;
         }

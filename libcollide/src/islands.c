@@ -138,7 +138,7 @@ int lc_islands_build(lc_world *w, lc_islands *is, double dt, const uint8_t *froz
         double bulge = w->shape[i].radius * (turn < 3.0 ? turn * turn / 8.0 : 1.0);
         /* a body in a pile strays from its predicted path by what the contacts do to it */
         double pile = w->rests_dissipative[i] ? LC_ISLAND_MARGIN * w->shape[i].min_edge : 0.0;
-        lc_swept_box(w, w->state, pred, i, w->def.contact_distance + bulge + pile, b);
+        lc_end_poses_box(w, w->state, pred, i, w->def.contact_distance + bulge + pile, b);
         if (reach != NULL && reach[4 * i] <= reach[4 * i + 2]) {
             b[0] = fmin(b[0], reach[4 * i]);
             b[1] = fmin(b[1], reach[4 * i + 1]);
@@ -252,7 +252,7 @@ int lc_islands_unforeseen(lc_world *w, lc_islands *is, const double *start, doub
         double turn = fabs(w->state[i * 6 + SA] - start[i * 6 + SA]);
         double bulge = w->shape[i].radius * (turn < 3.0 ? turn * turn / 8.0 : 1.0);
         const double *b = &boxes[4 * i], *p = &built[4 * i];
-        lc_swept_box(w, start, w->state, i, w->def.contact_distance + bulge, &boxes[4 * i]);
+        lc_end_poses_box(w, start, w->state, i, w->def.contact_distance + bulge, &boxes[4 * i]);
         if (b[0] < p[0] || b[1] < p[1] || b[2] > p[2] || b[3] > p[3]) outside = 1;
     }
     /* every path inside the box its island was built with: the build's pairs hold every meeting */

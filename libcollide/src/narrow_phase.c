@@ -292,7 +292,10 @@ static int crossings_one_way(const lc_world *w, int a, int b, frame fa0, frame f
             c[count].b = b;
             c[count].vertex = i;
             c[count].edge = hit;
-            c[count].toi = 0.0;
+            c[count].t_lo = 0.0;
+            c[count].toi = -1.0;
+            c[count].clear_to = 0.0;
+            c[count].by_pair = 0;
             c[count].t_hi = -1.0;   /* the caller knows the interval */
             count++;
         }

@@ -119,23 +119,28 @@ double lc_time_of_impact(lc_world *w, const double *s0, double h, const lc_cross
  * the crossing tests sees, and be inside at that root. The separating-axis distance of the pair is
  * continuous in time and negative exactly when the two overlap, so bisecting on it from a separated
  * start finds a time at which the pair touches at the contact gap and nothing overlaps. */
-double lc_pair_time_of_impact(lc_world *w, const double *s0, double h, int a, int b,
-                              const int *rows, int nrows, lc_touch *touches, int ntouches, double *scratch)
+double lc_pair_time_of_impact(lc_world *w, const double *s0, double h, int a, int b, const int *rows, int nrows,
+                              lc_touch *touches, int ntouches, double reach, double *scratch)
 {
     const lc_world_def *d = &w->def;
-    double lo = 0.0, hi = h;
+    double lo = 0.0, hi = h, g_lo = reach < INFINITY ? lc_pair_separation(w, s0, a, b) - d->contact_gap : 0.0;
     int it;
     w->last.toi_searches++;
     /* the pair's rows as at s0 (a static body is not integrated), the others not read */
     memcpy(&scratch[a * 6], &s0[a * 6], 6 * sizeof(double));
     memcpy(&scratch[b * 6], &s0[b * 6], 6 * sizeof(double));
-    for (it = 0; it < 200 && hi - lo > d->toi_time_tolerance; ++it) {
+    for (it = 0; it < 200 && (hi - lo > d->toi_time_tolerance || g_lo > reach); ++it) {
         double m = 0.5 * (lo + hi), g;
         if (lc_integrate_rows(w, s0, m, rows, nrows, touches, ntouches, scratch) != 0) return -1.0;
         w->last.toi_iterations++;
         g = lc_pair_separation(w, scratch, a, b) - d->contact_gap;
         if (!isfinite(g)) return -1.0;
-        if (g > 0.0) lo = m; else hi = m;
+        if (g > 0.0) {
+            lo = m;
+            g_lo = g;
+        } else {
+            hi = m;
+        }
         if (g > 0.0 && g <= d->toi_distance_tolerance) break;
     }
     return lo;

@@ -257,9 +257,16 @@ int lc_collect_touches(const lc_world *w, const double *state, int a, int b, dou
  * passing just beyond the end of an edge (over a seam between two slabs) for one that will hit it. */
 int lc_collect_touches_within(const lc_world *w, const double *state, int a, int b, double max_gap, double extent,
                               lc_buf *buf, int count);
-/* Crossing found between two states: vertex of row a entered edge of row b. */
-/* t_hi: a time (from the interval's start) by which the vertex is known to be inside. */
-typedef struct lc_crossing { int a, b, vertex, edge; double toi, t_hi; } lc_crossing;
+/* Crossing found between two states: vertex of row a entered edge of row b. Its time of impact lies
+ * in [t_lo, t_hi] from the interval's start: outside at t_lo, known to be inside by t_hi. Once
+ * searched: toi, that time from the start of the event regime's step (< 0: none found), clear_to, a
+ * time from the interval's start before which it has none, and by_pair, 1 when toi is the pair's first
+ * touch by its separation rather than the vertex's. */
+typedef struct lc_crossing {
+    int a, b, vertex, edge;
+    double t_lo, t_hi, toi, clear_to;
+    int by_pair;
+} lc_crossing;
 /* Appends crossings of the pair (a, b) between state0 and state1. Returns new count or -1. */
 int lc_find_crossings(const lc_world *w, const double *s0, const double *s1, int a, int b,
                       lc_buf *buf, int count);
@@ -281,8 +288,11 @@ int lc_broad_phase(lc_world *w, const double *s0, const double *s1, double margi
  * bound of their distance that, unlike the bounding circles, stays tight for a block over a long
  * floor or beside a wall (boxes from the per-body cache). */
 double lc_bounds_gap(const lc_world *w, const double *state, int a, int b);
-/* Body row's box over the interval (both end poses) grown by margin: x0, y0, x1, y1. */
+/* Body row's box over the interval grown by margin (x0, y0, x1, y1), as the pair searches take it: its
+ * end poses' boxes, or its bounding circle's where it turns more than LC_MAX_TRIAL_ROTATION. */
 void lc_swept_box(lc_world *w, const double *s0, const double *s1, int row, double margin, double out[4]);
+/* Body row's end poses' boxes, joined and grown by margin (the caller allows for the turn between). */
+void lc_end_poses_box(lc_world *w, const double *s0, const double *s1, int row, double margin, double out[4]);
 /* Candidate pairs, as lc_broad_phase, of given boxes (4 doubles per row: x0, y0, x1, y1). */
 int lc_broad_phase_boxes(lc_world *w, const double *boxes4, lc_buf *buf);
 /* The same, restricted to pairs with at least one of the nlist bodies in list (marked[row] != 0). */
@@ -414,9 +424,11 @@ void lc_counters_add(lc_counters *total, const lc_counters *last);
 double lc_time_of_impact(lc_world *w, const double *s0, double h, const lc_crossing *c,
                          const int *rows, int nrows, lc_touch *touches, int ntouches, double *scratch);
 /* Time in [0, h] at which bodies a and b, separated by more than the contact gap at s0 and overlapping
- * at s0 + h, are separated by the contact gap again (bisection on their separating-axis distance). */
-double lc_pair_time_of_impact(lc_world *w, const double *s0, double h, int a, int b,
-                              const int *rows, int nrows, lc_touch *touches, int ntouches, double *scratch);
+ * at s0 + h, are separated by the contact gap again (bisection on their separating-axis distance), to
+ * toi_time_tolerance and, beyond it, until they are at most `reach` farther apart than the contact gap
+ * (INFINITY: the time tolerance only). */
+double lc_pair_time_of_impact(lc_world *w, const double *s0, double h, int a, int b, const int *rows, int nrows,
+                              lc_touch *touches, int ntouches, double reach, double *scratch);
 
 /* ---- energy.c ---- */
 void lc_compute_energy(const lc_world *w, const double *state, lc_energy *out);
