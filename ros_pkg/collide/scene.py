@@ -617,8 +617,21 @@ def load_scene_text(text: str, source: str, validate: bool = True) -> Scene:
         scene = _from_data(data, _Parsed(source), validate)
     except SceneError:
         return _load_lined(text, source, is_json, validate)
-    scene._relines = lambda: _parse_text(text, source, is_json)[1].lines
+    scene._relines = _LinesOf(text, source, is_json)
     return scene
+
+
+@dataclass(frozen=True)
+class _LinesOf:
+    """The lines of a file's values, read by the line-numbered reader when a message needs them (a
+    class, not a closure: a Scene stays picklable)."""
+
+    text: str
+    source: str
+    is_json: bool
+
+    def __call__(self) -> dict[Path_, int]:
+        return _parse_text(self.text, self.source, self.is_json)[1].lines
 
 
 def _load_lined(text: str, source: str, is_json: bool, validate: bool) -> Scene:
