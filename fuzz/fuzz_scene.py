@@ -4,6 +4,9 @@ Each input is a scene file: the first byte picks YAML or JSON, the rest is the f
 contract checked for every input:
   * load_scene(path) returns a Scene or raises SceneError (with a non-empty message) - any other
     exception (RecursionError, TypeError, KeyError, CollideError, ...) is a crash;
+  * the line-numbered reader alone (collide.scene's, which load_scene leaves a plain file to the fast
+    reader for) gives the same: an equal Scene of the same value types, or a SceneError with the same
+    message;
   * a returned Scene round-trips: load_scene(scene.to_dict()) == scene;
   * it builds, and stepping it a few times either succeeds with a finite state or raises
     CollideError (never anything else).
@@ -51,7 +54,9 @@ def check_one(data: bytes) -> None:
     except SceneError as exc:
         if not str(exc).strip() or not exc.errors:
             raise ContractViolation(f"SceneError without a message: {exc!r}") from exc
+        _same_as_lined(path, str(exc))
         return
+    _same_as_lined(path, scene)
     again = load_scene(scene.to_dict())
     if again != scene:
         raise ContractViolation(f"to_dict round trip changed the scene:\n{scene}\n!=\n{again}")
@@ -64,6 +69,27 @@ def check_one(data: bytes) -> None:
         return  # e.g. LC_ERR_NUMERIC for an absurd scene: reported, and the step was undone
     if not all(math.isfinite(x) for x in world.state.ravel().tolist()):
         raise ContractViolation("a successful step left a non-finite state")
+
+
+def _same_as_lined(path: Path, got: Any) -> None:
+    """The line-numbered reader gives what load_scene gave (a Scene, or a SceneError's message)."""
+    from collide import SceneError
+    from collide.scene import _load_lined, read_scene_text
+
+    try:
+        text = read_scene_text(path)
+    except SceneError:
+        return  # not UTF-8: load_scene refused it before either reader
+    try:
+        lined: Any = _load_lined(text, str(path), path.suffix == ".json", True)
+    except SceneError as exc:
+        lined = str(exc)
+    if isinstance(got, str) or isinstance(lined, str):
+        same = got == lined
+    else:
+        same = got == lined and repr(got.to_dict()) == repr(lined.to_dict())  # 1 and 1.0 are ==
+    if not same:
+        raise ContractViolation(f"load_scene and the line-numbered reader differ:\n{got}\n!=\n{lined}")
 
 
 def replay(paths: list[str]) -> int:
@@ -82,7 +108,7 @@ def replay(paths: list[str]) -> int:
 
 
 # Modules whose functions give coverage feedback: the parser/validator and what it calls.
-_INSTRUMENTED = ("collide.scene", "collide.world", "collide.body", "collide._convert")
+_INSTRUMENTED = ("collide.scene", "collide.scene_fast", "collide.world", "collide.body", "collide._convert")
 
 
 def _instrument(atheris: Any) -> int:

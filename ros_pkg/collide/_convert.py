@@ -9,6 +9,8 @@ import numpy as np
 
 
 def real(value: Any, what: str) -> float:
+    if type(value) is float:  # the common case, without the ABC checks (scene loads call this per field)
+        return value
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
         raise TypeError(f"{what} must be a real number, got {type(value).__name__} {value!r}")
     return float(value)

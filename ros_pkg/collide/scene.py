@@ -16,13 +16,14 @@ from typing import Any, Callable, Mapping, Union
 import yaml
 
 from ._ffi import CollideError
+from .scene_fast import PLAIN_NUMBER as _NUMBER, NotPlain, json_nests_too_deep, read_plain
 from .world import _DEF_FIELDS, _ENUMS, World
 
-__all__ = ["Scene", "SceneError", "load_scene", "default_scene", "DEFAULT_COLORS"]
+__all__ = ["Scene", "SceneError", "load_scene", "load_scene_text", "read_scene_text", "default_scene",
+           "DEFAULT_COLORS"]
 
 Path_ = tuple[Union[str, int], ...]
 _MISSING = object()
-_NUMBER = re.compile(r"[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?|[-+]?\.?(inf|Inf|INF)|\.?(nan|NaN|NAN)")
 DEFAULT_COLORS = ("#2ca02c", "#1f77b4", "#d62728", "#ff7f0e", "#9467bd", "#8c564b")  # block1 green
 
 
@@ -155,24 +156,6 @@ def _to_python(node: yaml.Node, path: Path_, parsed: _Parsed, ancestors: tuple[i
     return value
 
 
-# a string (to its closing quote, or to the end if unterminated: never backtracks) or a bracket
-_JSON_TOKEN = re.compile(r'"(?:[^"\\]|\\.)*"?|[\[\]{}]', re.DOTALL)
-
-
-def _json_nests_too_deep(text: str) -> bool:
-    """Whether brackets outside strings nest deeper than _MAX_DEPTH (json's decoder recurses per level)."""
-    depth = 0
-    for m in _JSON_TOKEN.finditer(text):
-        tok = m.group()
-        if tok in ("[", "{"):
-            depth += 1
-            if depth > _MAX_DEPTH:
-                return True
-        elif tok in ("]", "}"):
-            depth -= 1
-    return False
-
-
 def _compose(text: str, source: str) -> yaml.Node | None:
     loader = _DepthLimitedLoader(text, source)
     try:
@@ -185,7 +168,7 @@ def _parse_text(text: str, source: str, is_json: bool) -> tuple[Any, _Parsed]:
     parsed = _Parsed(source)
     # JSON syntax first: clear messages for a truncated or malformed file. Too deep a file skips it:
     # the composer below reports the depth with the path where it was exceeded.
-    if is_json and not _json_nests_too_deep(text):
+    if is_json and not json_nests_too_deep(text, _MAX_DEPTH):
         try:
             json.loads(text)
         except json.JSONDecodeError as exc:
@@ -457,6 +440,8 @@ class Scene:
     scanners: list[dict[str, Any]] = field(default_factory=list)  # for the ROS node; the engine ignores them
     source: str = field(default="<scene>", compare=False)
     _lines: dict[Path_, int] = field(default_factory=dict, repr=False, compare=False)
+    # a scene read by the fast reader keeps no lines: this reads them when a message needs one
+    _relines: Callable[[], dict[Path_, int]] | None = field(default=None, repr=False, compare=False)
 
     @property
     def names(self) -> list[str]:
@@ -489,6 +474,8 @@ class Scene:
 
     def _fail(self, path: Path_, exc: Exception) -> SceneError:
         p = _Parsed(self.source)
+        if not self._lines and self._relines is not None:
+            self._lines = self._relines()
         p.lines = self._lines
         p.error(path, str(exc))
         return SceneError(self.source, p.errors)
@@ -547,11 +534,11 @@ def _from_data(data: Any, parsed: _Parsed, validate: bool) -> Scene:
     if top is not _MISSING:
         if top["version"] != 1:
             parsed.error(("version",), f"unsupported version {top['version']} (this reader knows 1)")
-        names = [n for n in _WALL_NAMES] if top["walls"] else []
+        names = set(_WALL_NAMES) if top["walls"] else set()  # a set: a list is quadratic in the bodies
         for i, b in enumerate(top["bodies"]):
             if b["name"] in names:
                 parsed.error(("bodies", i, "name"), f"duplicate body name {b['name']!r}")
-            names.append(b["name"])
+            names.add(b["name"])
         for i, s in enumerate(top["springs"]):
             for key in ("body_a", "body_b"):
                 if s[key] is not None and s[key] not in names:
@@ -604,14 +591,52 @@ def load_scene(source: Union[str, os.PathLike[str], dict[str, Any]], validate: b
         return _from_data(copy.deepcopy(source), parsed, validate)
     if not isinstance(source, (str, os.PathLike)):
         raise TypeError(f"load_scene takes a path or a dict, got {type(source).__name__}")
-    path = Path(source)
+    return load_scene_text(read_scene_text(source), str(Path(source)), validate)
+
+
+def read_scene_text(path: Union[str, os.PathLike[str]]) -> str:
+    """The text of a scene file; SceneError (no such file, cannot read) as load_scene raises it."""
     try:
-        text = path.read_text(encoding="utf-8")
+        return Path(path).read_text(encoding="utf-8")
     except FileNotFoundError:
-        raise SceneError(str(path), [(None, "", "no such file")]) from None
+        raise SceneError(str(Path(path)), [(None, "", "no such file")]) from None
     except (OSError, UnicodeDecodeError) as exc:
-        raise SceneError(str(path), [(None, "", f"cannot read: {exc}")]) from None
-    data, parsed = _parse_text(text, str(path), is_json=path.suffix.lower() == ".json")
+        raise SceneError(str(Path(path)), [(None, "", f"cannot read: {exc}")]) from None
+
+
+def load_scene_text(text: str, source: str, validate: bool = True) -> Scene:
+    """A scene from the text of the file named ``source`` (JSON if it ends in .json, else YAML), exactly
+    as load_scene(source) reads it. A plain file is read by the fast reader (libyaml or json); anything
+    else, and any file with a problem, by the line-numbered reader, whose messages name the lines."""
+    is_json = Path(source).suffix.lower() == ".json"
+    try:
+        data = read_plain(text, is_json, _MAX_DEPTH, _MAX_NODES)
+    except NotPlain:
+        return _load_lined(text, source, is_json, validate)
+    try:
+        scene = _from_data(data, _Parsed(source), validate)
+    except SceneError:
+        return _load_lined(text, source, is_json, validate)
+    scene._relines = _LinesOf(text, source, is_json)
+    return scene
+
+
+@dataclass(frozen=True)
+class _LinesOf:
+    """The lines of a file's values, read by the line-numbered reader when a message needs them (a
+    class, not a closure: a Scene stays picklable)."""
+
+    text: str
+    source: str
+    is_json: bool
+
+    def __call__(self) -> dict[Path_, int]:
+        return _parse_text(self.text, self.source, self.is_json)[1].lines
+
+
+def _load_lined(text: str, source: str, is_json: bool, validate: bool) -> Scene:
+    """The line-numbered reader: PyYAML's Python composer, the line of every value kept."""
+    data, parsed = _parse_text(text, source, is_json)
     return _from_data(data, parsed, validate)
 
 

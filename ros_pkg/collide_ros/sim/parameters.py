@@ -13,12 +13,16 @@ from rclpy.parameter import Parameter
 import collide
 
 from collide_ros import params
+from collide_ros.sim.scene_file import SceneFile
 from collide_ros.sim.topology import WORLD_SETTINGS, scene_values
 
 
 class Parameters:
-    """Owns ``_p`` (name -> current value of every parameter of params.SPECS) and ``_scene_defaults``
-    (the scene file's settings, empty without a scene file)."""
+    """Owns ``_p`` (name -> current value of every parameter of params.SPECS), ``_scene_defaults``
+    (the scene file's settings, empty without a scene file), ``_scene_file`` (the scene file read last
+    and its Scene: the start and each reset parse it once, and again only when it changed) and
+    ``_start_world`` (the scene file's Scene and the World built from it for the defaults, until the
+    start's _build_world takes it)."""
 
     def _declare_parameters(self) -> None:
         """Declare every parameter. scene_file first: a scene file supplies the defaults of gravity,
@@ -27,9 +31,13 @@ class Parameters:
         sf = params.BY_NAME["scene_file"]
         scene_file = str(self.declare_parameter(sf.name, sf.default, params.descriptor(sf)).value)
         self._scene_defaults: dict[str, float] = {}
+        self._scene_file = SceneFile()
+        self._start_world: tuple[collide.Scene, collide.World] | None = None
         if scene_file:
-            scene = collide.load_scene(scene_file)
-            self._scene_defaults = scene_values(scene, scene.build())
+            scene = self._scene_file.load(scene_file)
+            world = scene.build()  # the start's world too (Topology._build_world), if the file stays the same
+            self._scene_defaults = scene_values(scene, world)
+            self._start_world = (scene, world)
         for spec in params.SPECS:
             if spec.name == sf.name:
                 continue

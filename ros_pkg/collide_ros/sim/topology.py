@@ -38,14 +38,15 @@ class Topology:
 
     def _scene(self) -> collide.Scene:
         if self._p["scene_file"]:
-            return collide.load_scene(self._p["scene_file"])
+            return self._scene_file.load(self._p["scene_file"])  # re-read, parsed again if it changed
         return collide.default_scene(blocks=int(self._p["blocks"]), green_mass=float(self._p["green_mass"]),
                                      gravity=float(self._p["gravity"]), elasticity=float(self._p["elasticity"]),
                                      damping=float(self._p["damping"]))
 
     def _build_world(self) -> None:
         scene = self._scene()
-        world = scene.build()
+        start, self._start_world = self._start_world, None
+        world = start[1] if start is not None and start[0] is scene else scene.build()
         self._colors = {b["name"]: b.get("color") for b in scene.bodies}
         self._scanner_specs = [ScannerSpec.from_scene(sc) for sc in scene.scanners]
         if self._p["scene_file"]:
