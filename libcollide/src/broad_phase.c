@@ -326,24 +326,26 @@ int lc_broad_phase(lc_world *w, const double *s0, const double *s1, double margi
     return pairs_of(w, boxes, buf);
 }
 
+static void box_out(const box *b, double out[4])
+{
+    out[0] = b->x0;
+    out[1] = b->y0;
+    out[2] = b->x1;
+    out[3] = b->y1;
+}
+
 void lc_swept_box(lc_world *w, const double *s0, const double *s1, int row, double margin, double out[4])
 {
     box b;
     swept_box(w, s0, s1, row, margin, &b);
-    out[0] = b.x0;
-    out[1] = b.y0;
-    out[2] = b.x1;
-    out[3] = b.y1;
+    box_out(&b, out);
 }
 
 void lc_end_poses_box(lc_world *w, const double *s0, const double *s1, int row, double margin, double out[4])
 {
     box b;
     end_box(w, s0, s1, row, margin, &b);
-    out[0] = b.x0;
-    out[1] = b.y0;
-    out[2] = b.x1;
-    out[3] = b.y1;
+    box_out(&b, out);
 }
 
 int lc_broad_phase_boxes(lc_world *w, const double *boxes4, lc_buf *buf)

@@ -3,31 +3,15 @@ scene file validator and C accept it, and that nothing overlaps at the start. No
 nothing is timed."""
 from __future__ import annotations
 
-import importlib.util
-import sys
-from pathlib import Path
-from types import ModuleType
 from typing import Any
 
 import numpy as np
 import pytest
 
 import collide
+from node_bench_module import load_node_bench
 
-ROOT = Path(__file__).resolve().parents[2]
-
-
-def _load() -> ModuleType:
-    """bench/node_bench.py as the module bench_node_bench (registered: its dataclasses need it)."""
-    spec = importlib.util.spec_from_file_location("bench_node_bench", ROOT / "bench" / "node_bench.py")
-    assert spec is not None and spec.loader is not None
-    mod = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = mod
-    spec.loader.exec_module(mod)
-    return mod
-
-
-nb = _load()
+nb = load_node_bench()
 
 
 @pytest.fixture(scope="module")

@@ -42,29 +42,30 @@ def test_scene_file_bodies_and_settings(scene_sim: tuple[SimClient, NodeProcess]
     assert sim.wait_subscribed("crate/thrust", WrenchStamped)
 
 
-def test_bad_scene_file_is_reported(tmp_path: Path) -> None:
-    bad = tmp_path / "bad.yaml"
-    bad.write_text("version: 1\nbodies:\n  - {name: x, shape: box, width: 1, height: 1, mass: heavy}\n")
-    proc = NodeProcess("-p", f"scene_file:={bad}")
+def _start_fails(scene_file: Path) -> str:
+    """Starts the node on scene_file, expects it to exit with status 2; returns its output."""
+    proc = NodeProcess("-p", f"scene_file:={scene_file}")
     try:
         code = proc.proc.wait(60.0)
     finally:
         proc.stop()
-    assert code == 2
-    assert "bad.yaml" in proc.output() and "mass" in proc.output()
+    assert code == 2, proc.output()
+    return proc.output()
+
+
+def test_bad_scene_file_is_reported(tmp_path: Path) -> None:
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("version: 1\nbodies:\n  - {name: x, shape: box, width: 1, height: 1, mass: heavy}\n")
+    out = _start_fails(bad)
+    assert "bad.yaml" in out and "mass" in out
 
 
 def test_bad_range_in_scene_file_is_reported_with_its_line(tmp_path: Path) -> None:
     """A value only C refuses (mass -1) stops the start with C's message at the body's line."""
     bad = tmp_path / "range.yaml"
     bad.write_text(SCENE.replace("mass: 2.0", "mass: -1"))
-    proc = NodeProcess("-p", f"scene_file:={bad}")
-    try:
-        code = proc.proc.wait(60.0)
-    finally:
-        proc.stop()
-    assert code == 2
-    assert f"{bad}:6: bodies[1]: mass = -1" in proc.output(), proc.output()
+    out = _start_fails(bad)
+    assert f"{bad}:6: bodies[1]: mass = -1" in out, out
 
 
 def test_reset_reads_the_scene_file_as_it_is_on_disk(tmp_path: Path) -> None:

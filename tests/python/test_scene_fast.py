@@ -4,7 +4,6 @@ what it leaves to the line-numbered reader, and that large or hostile files keep
 paths and depth limit. Nothing is timed (bench/scene_load.py times them)."""
 from __future__ import annotations
 
-import importlib.util
 import json
 import math
 import subprocess
@@ -20,6 +19,7 @@ import collide
 from collide import SceneError, load_scene
 from collide.scene import _MAX_DEPTH, _MAX_NODES, _load_lined, _parse_text, load_scene_text, read_scene_text
 from collide.scene_fast import NotPlain, read_plain
+from node_bench_module import load_node_bench
 
 ROOT = Path(__file__).resolve().parents[2]
 SCENES = ROOT / "scenes"
@@ -27,12 +27,7 @@ SCENES = ROOT / "scenes"
 
 def _node_bench() -> ModuleType:
     """bench/node_bench.py (its big_scene and pile_scene generate the scenes the benches load)."""
-    spec = importlib.util.spec_from_file_location("bench_node_bench", ROOT / "bench" / "node_bench.py")
-    assert spec is not None and spec.loader is not None
-    mod = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = mod
-    spec.loader.exec_module(mod)
-    return mod
+    return load_node_bench()
 
 
 def same(a: Any, b: Any) -> bool:
