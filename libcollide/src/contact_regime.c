@@ -243,8 +243,7 @@ static int impacts(lc_contact_island *c, lc_touch *t, int nt, double h)
      * micro-bounce that never dissipates; a pile at resting_speed 1e-2 kept bodies rocking at 2 mm/s
      * that way). Approaches slower than contact_tolerance are the solves' own noise. Under x += h v
      * (c->moreau_jean) the flow stops an approach itself, and the stage runs only for one faster than
-     * resting_speed, the collisions every regime reports. Only approaches faster than resting_speed
-     * count and are reported as collisions. */
+     * resting_speed. Only approaches faster than resting_speed count and are reported as collisions. */
     double gc = w->def.contact_gap, vmin = w->def.contact_tolerance;
     double vr = w->def.resting_speed;
     int real = 0, bounced = 0;
@@ -258,9 +257,11 @@ static int impacts(lc_contact_island *c, lc_touch *t, int nt, double h)
         int closed = t[i].gap < w->def.contact_distance;
         lc_contact_island_row(c, &t[i], &rows[m]);
         lc_contact_row_velocity(&rows[m], c->b.v0, &un, &ut);
-        /* a large island has no located arrivals: a point that would arrive in the first half of the
-         * step would need a bounce to keep its gap under the trapezoidal update, so it is an impact now */
-        if (!closed && (c->moreau_jean || !(!c->small && un < 0.0 && t[i].gap - gc < -0.5 * un * h))) continue;
+        /* an island of several bodies has no located arrivals: a point that would arrive in the first
+         * half of the step is an impact now, at its approach speed (under the trapezoidal update it would
+         * need a bounce to keep its gap; under x += h v the flow would clip its speed to what closes the
+         * gap by the step's end, a 3 m/s arrival 2 cm away to 1.2 m/s) */
+        if (!closed && !(!c->small && un < 0.0 && t[i].gap - gc < -0.5 * un * h)) continue;
         t[i].vn_pre = un;
         /* under x += h v the flow itself stops an approach slower than resting_speed */
         if (un < -(c->moreau_jean ? vr : vmin)) fast = 1;

@@ -135,8 +135,8 @@
  * flow, since a velocity error moves positions twice as far as under the trapezoidal rule: below this
  * size the solves run to contact_tolerance (LC_CONTACT_SMALL_POINTS). In larger islands the sweeps
  * stall and the overlaps and projections that follow cost more than the impacts saved (mixed boxes,
- * bench/contact.py: 30 boxes -30 to -56 % of instructions over three seeds, 100 boxes +17, -17 and -26 %
- * at this size and up to +35 % at 128 points, the block pushing a row of 40 +28 % at 128). An island
+ * bench/contact.py: 30 boxes -20, -66 and -5 % of instructions over three seeds, 100 boxes +8, -2 and
+ * -4 % at this size and up to +35 % at 128 points, the block pushing a row of 40 +28 % at 128). An island
  * of one body keeps the trapezoidal rule, exact under constant forces (a block sliding to a stop at
  * v^2 / (2 mu g)). */
 #define LC_CONTACT_MOREAU_JEAN_POINTS 64

@@ -34,7 +34,11 @@
  *      stage runs, reports it at -0.5 m/s at each point of the face, and the block stops, every block
  *      at rest, nothing moved (1e-9 m) and exactly its kinetic energy, 0.125 J, lost (1e-9 J); with
  *      e = 0.5 the block leaves at e 0.5 - g h (Poisson's restitution off the resting stack, then
- *      gravity over the step), to 1e-9 m/s, and the blocks below stay. */
+ *      gravity over the step), to 1e-9 m/s, and the blocks below stay. A block arriving on the stack
+ *      within the first half of a step (3 m/s, 2 cm above it) is an impact at its full speed: the
+ *      collision is reported at -3 m/s and the block leaves at 1.5 - g h, to 1e-9 m/s (a bounce a
+ *      centimetre early; the flow alone would have clipped the arrival to the 1.2 m/s that closes
+ *      the gap by the step's end). */
 #include "check.h"
 #include "scenes.h"
 
@@ -323,6 +327,37 @@ static void moreau_jean_substep(double e, double speed)
     lc_world_destroy(w);
 }
 
+/* (7): a block 2 cm above a resting 3-stack falls onto it at 3 m/s (e = 0.5 everywhere). */
+static void moreau_jean_arrival(void)
+{
+    lc_world *w = world_with_floor(LC_REGIME_AUTO, 0.5);
+    lc_body_id ids[4];
+    lc_counters c;
+    const lc_contact *cs;
+    double v_off = 0.0;
+    int i, nc, hits = 0;
+    if (!w) return;
+    for (i = 0; i < 3; ++i) ids[i] = block(w, 0.0, 0.25 + 0.5 * i, 0.0, 0.5);
+    run(w, 60);
+    ids[3] = sc_box(w, 1.0, 0.5, 0.0, 1.75 + 0.02, 0.0, 0.0, -3.0, 0.0, 1.0, 0.5);
+    lc_body_set_material(w, ids[3], 0.5, 0.5);
+    c = run(w, 1);
+    lc_world_get_contacts(w, &cs, &nc);
+    for (i = 0; i < nc; ++i)
+        if (cs[i].kind == LC_CONTACT_COLLISION) {
+            hits++;
+            v_off = fmax(v_off, fabs(cs[i].normal_velocity + 3.0));
+        }
+    printf("moreau-jean arrival: contact islands %llu, collisions %d (off by %.3g m/s), vy %.12f\n",
+           (unsigned long long)c.contact_islands, hits, v_off, sc_row(w, ids[3])[4]);
+    CHECK(c.contact_islands == 1, "the falling block and the stack are one contact-regime island (%llu)",
+          (unsigned long long)c.contact_islands);
+    CHECK(hits >= 1 && v_off <= 1e-9, "the arrival is reported at -3 m/s (%d points, off by %.3g m/s)", hits, v_off);
+    CHECK(fabs(sc_row(w, ids[3])[4] - (1.5 - G * DT)) <= 1e-9, "the block leaves at e 3 - g h (%.12f)",
+          sc_row(w, ids[3])[4]);
+    lc_world_destroy(w);
+}
+
 int main(void)
 {
     rule();
@@ -334,5 +369,6 @@ int main(void)
     moreau_jean_substep(0.0, 5e-5);
     moreau_jean_substep(0.0, 0.5);
     moreau_jean_substep(0.5, 0.5);
+    moreau_jean_arrival();
     return CHECK_SUMMARY("test_contact_regime");
 }
