@@ -392,7 +392,9 @@ def run(out: Path, duration: float, gif: bool, do_replay: bool, view: bool = Tru
             drv.send(cue(s, anchor or (0.0, 0.0)))
             next_tick += period
             drv.spin(max(0.0, next_tick - time.monotonic()))
-        drv.spin(0.3)
+        # the node applies and echoes the last commands at its next steps, a loaded machine's steps
+        # late: the recording goes on long enough for each command's echo to reach the bag
+        drv.spin(2.0)
     finally:
         rc_rec = rec.stop() if rec is not None else -1
         if viewer is not None:
