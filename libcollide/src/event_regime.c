@@ -172,6 +172,15 @@ static void copy_row_spin(double *s0, const double *state, int r, spin_max *m)
     memcpy(&s0[r * 6], &state[r * 6], 6 * sizeof(double));
 }
 
+/* c's pair from s0 to time t into out (erows advanced only where advance): where each crossing check starts. */
+static int pair_state_at(lc_world *w, const double *s0, const lc_crossing *c, double t, int advance, const int *erows,
+                         int nerows, lc_touch *erest, int nerest, double *out)
+{
+    memcpy(&out[c->a * 6], &s0[c->a * 6], 6 * sizeof(double));
+    memcpy(&out[c->b * 6], &s0[c->b * 6], 6 * sizeof(double));
+    return advance ? lc_integrate_rows(w, s0, t, erows, nerows, erest, nerest, out) : 0;
+}
+
 /* The time of impact of crossing c within [c->t_lo, h] from s0, advancing the rows erows[0..nerows)
  * with the touches erest[0..nerest) (lc_time_of_impact), or -1. A crossing bracketed within a part of
  * the interval (event_crossings.h) is searched from the part's start, where its vertex is outside
@@ -182,9 +191,7 @@ static double crossing_toi(lc_world *w, const double *s0, const lc_crossing *c, 
     double lo = c->t_lo, tau;
     if (!(lo > 0.0)) return lc_time_of_impact(w, s0, h, c, erows, nerows, erest, nerest, scratch);
     if (!(lo < h)) return -1.0;
-    memcpy(&at_lo[c->a * 6], &s0[c->a * 6], 6 * sizeof(double));
-    memcpy(&at_lo[c->b * 6], &s0[c->b * 6], 6 * sizeof(double));
-    if (lc_integrate_rows(w, s0, lo, erows, nerows, erest, nerest, at_lo) != 0) return -1.0;
+    if (pair_state_at(w, s0, c, lo, 1, erows, nerows, erest, nerest, at_lo) != 0) return -1.0;
     tau = lc_time_of_impact(w, at_lo, h - lo, c, erows, nerows, erest, nerest, scratch);
     return tau < 0.0 ? tau : lo + tau;
 }
@@ -203,22 +210,16 @@ static double check_touch(lc_world *w, const double *s0, lc_crossing *c, double 
                           lc_touch *erest, int nerest, double *at, double *scratch)
 {
     double sep, lo = c->t_lo, t2;
-    memcpy(&at[c->a * 6], &s0[c->a * 6], 6 * sizeof(double));
-    memcpy(&at[c->b * 6], &s0[c->b * 6], 6 * sizeof(double));
-    if (lc_integrate_rows(w, s0, tau, erows, nerows, erest, nerest, at) != 0) return -2.0;
+    if (pair_state_at(w, s0, c, tau, 1, erows, nerows, erest, nerest, at) != 0) return -2.0;
     sep = lc_pair_separation(w, at, c->a, c->b);
     if (sep > w->def.contact_distance) {
         /* the pair at the bracket's end: apart there, it has no touch to find */
-        memcpy(&scratch[c->a * 6], &s0[c->a * 6], 6 * sizeof(double));
-        memcpy(&scratch[c->b * 6], &s0[c->b * 6], 6 * sizeof(double));
-        if (lc_integrate_rows(w, s0, c->t_hi, erows, nerows, erest, nerest, scratch) != 0) return -2.0;
+        if (pair_state_at(w, s0, c, c->t_hi, 1, erows, nerows, erest, nerest, scratch) != 0) return -2.0;
         if (!(lc_pair_separation(w, scratch, c->a, c->b) < w->def.contact_gap)) return -1.0;
         lo = tau;
     } else if (sep < -0.5 * w->def.contact_gap) {
         /* the pair at the bracket's start */
-        memcpy(&at[c->a * 6], &s0[c->a * 6], 6 * sizeof(double));
-        memcpy(&at[c->b * 6], &s0[c->b * 6], 6 * sizeof(double));
-        if (lo > 0.0 && lc_integrate_rows(w, s0, lo, erows, nerows, erest, nerest, at) != 0) return -2.0;
+        if (pair_state_at(w, s0, c, lo, lo > 0.0, erows, nerows, erest, nerest, at) != 0) return -2.0;
         if (!(lc_pair_separation(w, at, c->a, c->b) > w->def.contact_gap)) return tau;   /* touching there already */
     } else {
         return tau;
