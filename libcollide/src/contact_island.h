@@ -25,6 +25,7 @@ typedef struct lc_contact_island {
     lc_island_bodies b;
     int small;           /* transitions are located (LC_CONTACT_LOCATE_MAX_BODIES) */
     int moreau_jean;     /* this sub-step moves positions by h v (LC_CONTACT_MOREAU_JEAN_POINTS) */
+    int pile;            /* this sub-step is a pile sub-step: one solve, restitution in the flow (LC_CONTACT_PILE_BODIES) */
     int precise;         /* solves run to convergence (LC_CONTACT_PRECISE_SWEEPS, _EXACT_POINTS) */
     double max_h;        /* s, the longest sub-step (0: the whole step, cut only at transitions) */
     double slack;        /* m, the projection's stop and trigger (LC_CONTACT_PROJECTION_SLACK or _LARGE_SLACK) */

@@ -2,22 +2,25 @@
  * time stepping. A step of h is
  *   1. contacts: every vertex-edge point of the island's pairs within contact_distance, or within the
  *      distance the pair can close in the step (speculative points);
- *   2. impacts: points touching (or, in a large island, arriving within the first half of the step)
- *      that approach get the compression impulse that stops every approach, then Poisson's
+ *   2. impacts: points touching (or, in an island of several bodies, arriving within the first half of
+ *      the step) that approach get the compression impulse that stops every approach, then Poisson's
  *      restitution e j_c where their approach was fast enough to bounce, then a second compression
  *      that stops what the restitution drove into other touches; in a Moreau-Jean sub-step (step 5)
- *      only when a touching point approaches faster than resting_speed;
+ *      only when a touching point approaches faster than resting_speed; in a pile sub-step
+ *      (LC_CONTACT_PILE_BODIES) never: the flow's targets hold Newton's restitution instead;
  *   3. flow: one complementarity problem in the contact impulses over h: with v = v_0 + h M^-1 F + M^-1
  *      J^T lambda, each point's normal velocity at the end keeps its gap at or above the contact gap
  *      under the sub-step's position update (trapezoidal: u_n >= -u_n0 - 2 (gap - contact_gap)^+ / h;
- *      Moreau-Jean: u_n >= -(gap - contact_gap)^+ / h), Coulomb
+ *      Moreau-Jean: u_n >= -(gap - contact_gap)^+ / h; an impact point of a pile sub-step:
+ *      u_n >= -e u_n0 if it bounces, else, arriving, u_n >= 0), Coulomb
  *      friction in the exact 2D cone, warm-started from the last step's forces (contact_cache.c),
  *      solved by nonsmooth Gauss-Seidel (contact_solver.c), and in a precise retry of few points exactly
  *      (contact_active_set.c, else contact_exact.c);
  *   4. in small islands, a stick-slip transition or a new contact's arrival inside the step cuts the
  *      step there, and the rest is taken again from step 1;
  *   5. positions: x += h (v_0 + v) / 2 (exact under constant forces), or x += h v (Moreau-Jean) in a
- *      sub-step of several bodies and fewer than LC_CONTACT_MOREAU_JEAN_POINTS points;
+ *      sub-step of several bodies and fewer than LC_CONTACT_MOREAU_JEAN_POINTS points, and in a pile
+ *      sub-step;
  *   6. a projection moves overlapping points out by the smallest mass-weighted displacement (a large
  *      pass starting from active sets over a sparse factorization: contact_projection.c), and an
  *      island without driving forces that still ends with more energy than it began with gives the
@@ -233,8 +236,20 @@ static void count_solve(lc_contact_island *c, lc_contact_solve s, int rows)
     if (s.residual > c->residual) c->residual = s.residual;
 }
 
-/* Step 2: impacts at the start of the sub-step. Changes b.v0. Returns the points that received an
- * impulse, or -1. */
+/* Whether a point approaching at un (< 0) is an impact at the sub-step's start: it touches, or, in an
+ * island of several bodies (whose arrivals are not located), it would arrive within the first half of
+ * the step: it bounces at its approach speed, at most half a step's travel early (under the
+ * trapezoidal update it would need a bounce to keep its gap; under x += h v the flow would clip its
+ * speed to what closes the gap by the step's end, a 3 m/s arrival 2 cm away to 1.2 m/s). */
+static int impact_point(const lc_contact_island *c, const lc_touch *t, double un, double h)
+{
+    const lc_world *w = c->w;
+    if (t->gap < w->def.contact_distance) return 1;
+    return !c->small && un < 0.0 && t->gap - w->def.contact_gap < -0.5 * un * h;
+}
+
+/* Step 2: impacts at the start of the sub-step (none in a pile sub-step: its flow holds them). Changes
+ * b.v0. Returns the points that received an impulse, or -1. */
 static int impacts(lc_contact_island *c, lc_touch *t, int nt, double h)
 {
     lc_world *w = c->w;
@@ -244,24 +259,20 @@ static int impacts(lc_contact_island *c, lc_touch *t, int nt, double h)
      * that way). Approaches slower than contact_tolerance are the solves' own noise. Under x += h v
      * (c->moreau_jean) the flow stops an approach itself, and the stage runs only for one faster than
      * resting_speed. Only approaches faster than resting_speed count and are reported as collisions. */
-    double gc = w->def.contact_gap, vmin = w->def.contact_tolerance;
-    double vr = w->def.resting_speed;
+    double vmin = w->def.contact_tolerance, vr = w->def.resting_speed;
     int real = 0, bounced = 0;
-    lc_contact_row *rows = lc_buf_get(&c->cr->b_irows, (size_t)(nt > 0 ? nt : 1) * sizeof(lc_contact_row));
+    lc_contact_row *rows;
     int *which, i, m = 0, fast = 0, hits = 0;
+    if (c->pile) return 0;
+    rows = lc_buf_get(&c->cr->b_irows, (size_t)(nt > 0 ? nt : 1) * sizeof(lc_contact_row));
     if (rows == NULL) return -1;
     which = (int *)lc_buf_get(&c->cr->b_hash, (size_t)(nt > 0 ? nt : 1) * sizeof(int));
     if (which == NULL) return -1;
     for (i = 0; i < nt; ++i) {
         double un, ut;
-        int closed = t[i].gap < w->def.contact_distance;
         lc_contact_island_row(c, &t[i], &rows[m]);
         lc_contact_row_velocity(&rows[m], c->b.v0, &un, &ut);
-        /* an island of several bodies has no located arrivals: a point that would arrive in the first
-         * half of the step is an impact now, at its approach speed (under the trapezoidal update it would
-         * need a bounce to keep its gap; under x += h v the flow would clip its speed to what closes the
-         * gap by the step's end, a 3 m/s arrival 2 cm away to 1.2 m/s) */
-        if (!closed && !(!c->small && un < 0.0 && t[i].gap - gc < -0.5 * un * h)) continue;
+        if (!impact_point(c, &t[i], un, h)) continue;
         t[i].vn_pre = un;
         /* under x += h v the flow itself stops an approach slower than resting_speed */
         if (un < -(c->moreau_jean ? vr : vmin)) fast = 1;
@@ -365,6 +376,12 @@ static int flow(lc_contact_island *c, const lc_touch *t, int nt, double h, lc_co
         lc_contact_island_row(c, &t[i], r);
         lc_contact_row_velocity(r, c->b.v0, &un, &ut);
         r->target_n = c->moreau_jean ? -fmax(t[i].gap - gc, 0.0) / h : -un - 2.0 * fmax(t[i].gap - gc, 0.0) / h;
+        /* a pile sub-step's impacts (Newton's law): a bounce leaves at e times its approach, an arrival
+         * within the step's first half stops now, as the impact stage would stop it */
+        if (c->pile && un < 0.0 && impact_point(c, &t[i], un, h)) {
+            if (un < -lc_bounce_speed(w, t[i].elasticity)) r->target_n = -t[i].elasticity * un;
+            else if (!(t[i].gap < w->def.contact_distance)) r->target_n = 0.0;
+        }
         r->slip = ut > slip_speed ? 1 : ut < -slip_speed ? -1 : 0;
         known[i] = (uint8_t)lc_contact_cache_find(c->cr->cache, key_of(w, &t[i]), &fn, &ft);
         if (known[i]) {
@@ -374,6 +391,27 @@ static int flow(lc_contact_island *c, const lc_touch *t, int nt, double h, lc_co
     }
     if (cold_start(c, t, nt, h, known, rows) != 0) return -1;
     return solve(c, rows, nt);
+}
+
+/* The collisions of a pile sub-step: its impact points that approached faster than resting_speed and
+ * took an impulse, reported with the flow's impulses. 0, or -1 without memory. */
+static int record_pile_impacts(lc_contact_island *c, lc_touch *t, const lc_contact_row *rows, int nt, double h)
+{
+    lc_world *w = c->w;
+    int i, real = 0;
+    for (i = 0; i < nt; ++i) {
+        double un, ut;
+        lc_contact_row_velocity(&rows[i], c->b.v0, &un, &ut);
+        if (!(un < -w->def.resting_speed) || !(rows[i].lambda_n > 0.0) || !impact_point(c, &t[i], un, h)) continue;
+        t[i].vn_pre = un;
+        t[i].value = rows[i].lambda_n;
+        t[i].tangent = rows[i].lambda_t;
+        real = 1;
+        w->last.impulses++;
+        if (lc_record_impact(w, &t[i], LC_IMPACT_CONTACT) != 0) return -1;
+    }
+    if (real) w->last.collisions++;
+    return 0;
 }
 
 /* Step 4: the fraction of h at which the first located transition happens (1: none). Arrivals: a
@@ -571,9 +609,14 @@ static int advance(lc_contact_island *c, double dt, double e0, double size0, int
         t = (lc_touch *)cr->b_touch.p;
         rows = lc_buf_get(&cr->b_rows, (size_t)(*nt > 0 ? *nt : 1) * sizeof(lc_contact_row));
         if (rows == NULL) return -1;
-        c->moreau_jean = !c->small && *nt < LC_CONTACT_MOREAU_JEAN_POINTS;
+        c->pile = isl->nrows >= LC_CONTACT_PILE_BODIES && isl->nrows < LC_CONTACT_LARGE_ISLAND_BODIES &&
+                  *nt >= LC_CONTACT_MOREAU_JEAN_POINTS;
+        c->moreau_jean = !c->small && (*nt < LC_CONTACT_MOREAU_JEAN_POINTS || c->pile);
+        c->slack = c->pile || isl->nrows >= LC_CONTACT_LARGE_ISLAND_BODIES ? LC_CONTACT_PROJECTION_LARGE_SLACK
+                                                                            : LC_CONTACT_PROJECTION_SLACK;
         for (i = 0; i < isl->nrows; ++i) memcpy(&c->b.v0[i * 3], &w->state[isl->rows[i] * 6 + 3], 3 * sizeof(double));
         if (impacts(c, t, *nt, h) < 0 || flow(c, t, *nt, h, rows) != 0) return -1;
+        if (c->pile && record_pile_impacts(c, t, rows, *nt, h) != 0) return -1;
         tau = c->small && cuts < LC_CONTACT_MAX_CUTS ? first_transition(c, t, rows, *nt, h) : 1.0;
         if (tau < 1.0 - LC_CONTACT_CUT_EPSILON) {
             /* solved again over the part of the step before the transition */
@@ -621,7 +664,6 @@ int lc_contact_advance(lc_world *w, lc_contact_regime *cr, const lc_island *isl,
     c.cr = cr;
     c.isl = isl;
     c.small = isl->nrows <= LC_CONTACT_LOCATE_MAX_BODIES;
-    c.slack = isl->nrows >= LC_CONTACT_LARGE_ISLAND_BODIES ? LC_CONTACT_PROJECTION_LARGE_SLACK : LC_CONTACT_PROJECTION_SLACK;
     c.dt = dt;
     if (map_island(&c) != 0) return -1;
     w->last.contact_islands++;

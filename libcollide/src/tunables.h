@@ -140,6 +140,23 @@
  * of one body keeps the trapezoidal rule, exact under constant forces (a block sliding to a stop at
  * v^2 / (2 mu g)). */
 #define LC_CONTACT_MOREAU_JEAN_POINTS 64
+/* A sub-step of an island of at least this many bodies, at least LC_CONTACT_MOREAU_JEAN_POINTS points
+ * and fewer than LC_CONTACT_LARGE_ISLAND_BODIES bodies is a pile sub-step: one solve, the flow, whose
+ * targets hold the impacts' Newton restitution (a point touching or arriving in the step's first half
+ * that approaches faster than the bounce speed must leave at e times its approach), positions by
+ * x += h v, and the large islands' projection slack (LC_CONTACT_PROJECTION_LARGE_SLACK). In such a pile
+ * Gauss-Seidel stalls: 100 mixed boxes piled in a box end their 200-point flow 1e-2 m/s from its answer
+ * after 30 sweeps, with 40-60 points still changing by 1e-3 m/s. The trapezoidal path's impact solves
+ * (a compression and a second compression after the bounce, run at every step where any closed point
+ * approaches) cannot converge either and only triple the sweeps, and projecting the overlaps those
+ * velocities leave (1e-4 m a step) to 4e-10 m took two passes of 50 sweeps. Instructions per step
+ * (callgrind, 300 steps of bench/contact.py's scenes) against the trapezoidal path: 100 mixed boxes -29,
+ * -40 and -34 % over three seeds, a box dropped on a base-12 pyramid -33 %, the block pushing a row of
+ * 40 -18 %, the base-20 pyramid -9 %. Islands of LC_CONTACT_LARGE_ISLAND_BODIES bodies or more keep the
+ * trapezoidal path: a velocity error moves positions twice as far under x += h v, and the settled
+ * 1 000-box pile's projection (active sets and MPRGP) then took +23 % of a step. Fewer bodies than this
+ * (a few polygons with many vertices) converge, and keep the exact impacts and the 4e-10 m slack. */
+#define LC_CONTACT_PILE_BODIES 16
 /* When a contact-regime step ends with an overlap it cannot project away or an energy gain the island's
  * kinetic energy cannot pay (a nearly resting island whose solves stopped at contact_iterations, 1e-4
  * to 5e-3 m/s off), the step is taken again with solves of up to this many sweeps and exact ones up to
@@ -186,7 +203,8 @@
 #ifndef LC_CONTACT_PROJECTION_SLACK
 #define LC_CONTACT_PROJECTION_SLACK 4e-10
 #endif
-/* m, the projection's slack in an island of at least LC_CONTACT_LARGE_ISLAND_BODIES bodies: a pile that
+/* m, the projection's slack in an island of at least LC_CONTACT_LARGE_ISLAND_BODIES bodies and in a pile
+ * sub-step (LC_CONTACT_PILE_BODIES): a pile that
  * large settles with its flow a millimetre deep every step (Gauss-Seidel stalls in its height), and
  * projecting that to 4e-10 m took the passes' second and third solves, a third of such a step's
  * instructions (a settling 1 000-box pile, callgrind); 1e-7 m is ten times inside the 1e-6 m the contact
@@ -194,8 +212,9 @@
 #define LC_CONTACT_PROJECTION_LARGE_SLACK 1e-7
 #define LC_CONTACT_LARGE_ISLAND_BODIES 300
 /* m, the overlap a contact-regime step may leave after its projection before the island is taken again
- * in the event regime: the test suites' 1e-9 m, ten times the projection's own aim; in a large island
- * scaled with its slack (2.5e-7 m). */
+ * (contact_regime.c): the test suites' 1e-9 m, ten times the projection's own aim; in a large island or
+ * a pile sub-step scaled with its slack (2.5e-7 m, four times inside the 1e-6 m the contact scenes are
+ * held to). */
 #define LC_CONTACT_OVERLAP_LEFT 1e-9
 /* The energy gain, relative to an island's energy (the sum of its terms' magnitudes), a contact-regime
  * step may leave when the island's kinetic energy cannot pay for it before the island is taken again

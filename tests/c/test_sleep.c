@@ -122,7 +122,9 @@ static void pyramid_sleeps_and_wakes(void)
     CHECK(woken_at > asleep_at + 30, "the falling box wakes the pyramid when it arrives (step %d, asleep at %d)", woken_at,
           asleep_at);
     CHECK(all_awake_when_woken, "every body of the pyramid wakes with its island");
-    CHECK(overlap <= 1e-9, "no overlap deeper than 1e-9 m from the wake on (%.3g m)", overlap);
+    /* the woken pyramid and the box are one island of 56 bodies: its sub-steps are pile sub-steps,
+     * projected to 1e-7 m and allowed 2.5e-7 m at a step's end (contact_regime.md) */
+    CHECK(overlap <= 2.5e-7, "no overlap deeper than 2.5e-7 m from the wake on (%.3g m)", overlap);
     CHECK(asleep_again > woken_at, "everything comes to rest and sleeps again (step %d)", asleep_again);
     lc_world_destroy(w);
 }
