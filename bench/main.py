@@ -2,7 +2,7 @@
 error on the seed and hard-case scenes (docs/benchmarks.md). Use bench/run (it installs bench/requirements.txt first).
 
     bench/run [--quick | --full] [--sections wp,ref,impacts,cradle,tunnel,stacks,hard,pyramid,scaling]
-    bench/run [--quick] --sections contact    # piles, pushing, friction (bench/contact.py)
+    bench/run [--quick] --sections contact [--seeds 1,2,3]   # piles, pushing, friction (bench/contact.py)
 
 Writes docs/benchmarks.md, docs/img/bench_*.png and bench/results/latest.json (and the results behind each
 page it writes: bench/results/benchmarks.json, bench_contact.json). The contact section is
@@ -353,10 +353,13 @@ class Bench:
     def contact(self) -> None:
         """Every contact scene for libcollide, Box2D v3 and Chipmunk, sampled every step. Its own
         CPU budget per libcollide run (--budget, else 20 s quick / 60 s), so that the section ends in
-        minutes even when libcollide is over budget on every scene; the peers always finish."""
+        minutes even when libcollide is over budget on every scene; the peers always finish. The
+        random piles run on --seeds (default 1,2,3; --quick: mixed1000 on the first only) and report
+        medians over the seeds (bench/contact.py)."""
         budget = self.args.budget or (contact.BUDGET_QUICK if self.quick else contact.BUDGET_DEFAULT)
+        seeds = contact.parse_seeds(self.args.seeds) if self.args.seeds else contact.SEEDS
         self.out["contact"] = contact.run_section(self.pool, list(contact.SCENE_KEYS), contact.ENGINES,
-                                                  self.repeats, budget, log)
+                                                  self.repeats, budget, log, seeds, self.quick)
 
 
 def main() -> int:
@@ -370,11 +373,15 @@ def main() -> int:
                     help="markdown file to write; the plots go to img/ next to it")
     ap.add_argument("--budget", type=float, help="CPU seconds per run before it is stopped (default 15, quick 4, "
                     "full 60; contact: libcollide runs only, default 60, quick 20)")
+    ap.add_argument("--seeds", help="comma list of seeds for the contact section's random piles (mixed30, "
+                    "mixed100, mixed1000; default 1,2,3; with --quick mixed1000 runs the first only)")
     ap.add_argument("--no-report", action="store_true", help="only write bench/results/latest.json")
     ap.add_argument("--scaling-n", help="comma list of body counts for the scaling section (e.g. 100,500,2000,5000,20000) "
                     "instead of its default list")
     ap.add_argument("--engines", help="comma list of engines for the scaling section (default: all; libcollide always)")
     args = ap.parse_args()
+    if args.seeds:
+        contact.parse_seeds(args.seeds)   # a bad list stops here, not after the sections before contact
     t0 = time.time()
     b = Bench(args)
     import importlib.metadata as md

@@ -243,3 +243,86 @@ def test_a_run_over_budget_keeps_its_steps_cpu_and_quality(contact: ModuleType) 
     assert len(table) == 3 and "over budget: 41/600 steps" in table[2] and "4 / 4 / 0" in table[2]
     assert "4 (s41)" in table[2]
     assert report.contact_notes(sec)
+
+
+def _seed_row(seed: int, engine: str, us: float, kind: str = "ok", **quality: object) -> dict:
+    """A per-seed row of one random pile as bench/contact.py's summarize makes it."""
+    steps = 300 if kind == "ok" else 41
+    return {"key": "mixed30", "scene": f"mixed30_s{seed}", "engine": engine, "label": engine, "bodies": 30,
+            "total_steps": 300, "steps": steps, "status": "ok" if kind == "ok" else "over_budget", "kind": kind,
+            "killed_in_step": False, "us_per_step": us, "seed": seed, "stages": {"steps": steps, "collisions": seed},
+            "max_overlap": 0.0, "overlap_sample": -1, "overlap_pair": [-1, -1], "escaped": 0, "escape_sample": -1,
+            "max_step_gain": -1e-3, "gain_step": 1, "e_change": -0.5, **quality}
+
+
+def test_random_piles_take_the_median_cost_and_the_worst_quality_over_seeds(contact: ModuleType) -> None:
+    # seed 3 is slow and over budget, seed 2 has the deepest overlap, seed 3 the most escapes, and
+    # seed 2 the largest energy gain though seeds 1 and 3 have larger |gain|: a mean (250 µs), a
+    # median of the quality (20 mm) or a largest |gain| would each give another row
+    lc = [_seed_row(1, "libcollide", 100.0, max_overlap=0.01, overlap_sample=10, escaped=1, escape_sample=9,
+                    max_step_gain=-1e-3, gain_step=4, e_change=-0.6),
+          _seed_row(2, "libcollide", 150.0, max_overlap=0.05, overlap_sample=20, overlap_pair=[3, 4],
+                    max_step_gain=2e-12, gain_step=77, e_change=-0.5),
+          _seed_row(3, "libcollide", 500.0, "over budget", max_overlap=0.02, overlap_sample=5, escaped=3,
+                    escape_sample=7, max_step_gain=-5e-4, gain_step=2, e_change=-0.1)]
+    b2 = [_seed_row(1, "box2d3", 50.0), _seed_row(2, "box2d3", 40.0), _seed_row(3, "box2d3", 60.0)]
+    for a, b in zip(lc, b2):
+        contact.add_ratios([a, b])                                   # per-seed ratios 2, 3.75, 8.33
+    rows = [contact.aggregate_seeds(lc), contact.aggregate_seeds(b2)]
+    contact.add_ratios(rows)
+    agg = rows[0]
+    assert agg["us_per_step"] == 150.0 and rows[1]["us_per_step"] == 50.0
+    assert math.isclose(agg["ratio_box2d3"], 3.0)                    # ratio of the medians, not 3.75
+    assert agg["seeds"] == [1, 2, 3] and agg["per_seed"] is lc and agg["per_seed"][0]["ratio_box2d3"] == 2.0
+    assert agg["max_overlap"] == 0.05 and agg["overlap_sample"] == 20 and agg["overlap_pair"] == [3, 4]
+    assert agg["max_overlap_seed"] == 2
+    assert (agg["escaped"], agg["escape_sample"], agg["escaped_seed"]) == (3, 7, 3)
+    assert (agg["max_step_gain"], agg["gain_step"], agg["max_step_gain_seed"]) == (2e-12, 77, 2)
+    assert agg["kind"] == "over budget" and agg["steps"] == 41 and agg["status_seed"] == 3
+    assert agg["e_change"] == -0.5 and agg["stages"] == {"steps": 641, "collisions": 6}
+    assert rows[1]["kind"] == "ok" and rows[1]["max_overlap"] == 0.0
+
+    report = _load("report")
+    sec = {"engines": ["libcollide", "box2d3"], "rows": rows, "repeats": 1, "dt": 1 / 60,
+           "settings": contact.CONTACT_SETTINGS, "budget_cpu_s": 20.0, "peer_budget_cpu_s": 600.0,
+           "scenes": {"mixed30": {"name": "mixed30_s1, mixed30_s2, mixed30_s3", "what": "pile", "bodies": 30,
+                                  "steps": 300, "at_rest": False, "seeds": [1, 2, 3]}}}
+    cells = [c.strip() for c in report.contact_table(sec)[2].split("|")[1:-1]]
+    assert cells[:4] == ["mixed30 (30, 300; seeds 1,2,3)", "150 (over budget: 41/300 steps, seed 3)", "50", "3×"]
+    assert cells[4:7] == ["50 (s20, seed 2)", "3 (s7, seed 3)", "+2e-12 (s77, seed 2)"]
+    notes = "\n".join(report.contact_notes(sec))
+    assert "- mixed30, seeds 1 / 2 / 3: libcollide 100 / 150 / 500 (over budget); Box2D v3 50 / 40 / 60; " \
+           "libcollide / Box2D v3 2× / 3.75× / 8.33×" in notes
+
+
+class _FakePool:
+    """harness.Pool's run() for run_section: every run finishes two steps at rest, its CPU set by the
+    seed (1 for a scene without one; the same for every engine), and the pool records which scene
+    each engine ran, in order."""
+
+    def __init__(self) -> None:
+        self.ran: list[tuple[str, str]] = []
+
+    def run(self, task: object) -> dict:
+        self.ran.append((task.engine, task.scene.name))
+        seed = task.scene.meta.get("seed", 1)
+        return {"engine": task.engine, "label": task.label, "status": "ok", "steps": 2, "cpu": 1e-4 * seed,
+                "states": np.repeat(task.scene.initial_state()[None], 3, axis=0), "stages": {"steps": 2}}
+
+
+def test_each_engine_runs_the_same_seeds_interleaved(contact: ModuleType) -> None:
+    pool = _FakePool()
+    sec = contact.run_section(pool, ["mixed30", "stack10"], ("libcollide", "box2d3"), 1, 20.0, lambda _: None,
+                              seeds=(4, 7), quick=True)
+    assert pool.ran == [("libcollide", "mixed30_s4"), ("box2d3", "mixed30_s4"), ("libcollide", "mixed30_s7"),
+                        ("box2d3", "mixed30_s7"), ("libcollide", "stack10_e0"), ("box2d3", "stack10_e0")]
+    mixed = [r for r in sec["rows"] if r["key"] == "mixed30"]
+    assert [r["seeds"] for r in mixed] == [[4, 7], [4, 7]]
+    assert all(math.isclose(r["us_per_step"], 1e6 * 1e-4 * 5.5 / 2) for r in mixed)   # median of 4 and 7
+    assert sec["scenes"]["mixed30"]["seeds"] == [4, 7] and "seeds" not in sec["scenes"]["stack10"]
+    assert "seeds" not in next(r for r in sec["rows"] if r["key"] == "stack10")
+    assert contact.seeds_for("mixed1000", (4, 7), quick=True) == (4,)
+    assert contact.seeds_for("mixed1000", (4, 7), quick=False) == (4, 7)
+    assert contact.parse_seeds(" 3, 1 ") == (3, 1)
+    with pytest.raises(SystemExit):
+        contact.parse_seeds("1,1")
