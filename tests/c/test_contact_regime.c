@@ -78,6 +78,27 @@ static lc_counters run(lc_world *w, int n)
     return c;
 }
 
+/* One step; e0 and e1 get the energy before and after, *hits the collisions it reported and *off the
+ * largest difference of their normal velocities from v (m/s). Returns the step's counters. */
+static lc_counters one_step(lc_world *w, double v, lc_energy *e0, lc_energy *e1, int *hits, double *off)
+{
+    const lc_contact *cs;
+    lc_counters c;
+    int i, nc = 0;
+    lc_world_get_energy(w, e0);
+    c = run(w, 1);
+    lc_world_get_energy(w, e1);
+    lc_world_get_contacts(w, &cs, &nc);
+    *hits = 0;
+    *off = 0.0;
+    for (i = 0; i < nc; ++i)
+        if (cs[i].kind == LC_CONTACT_COLLISION) {
+            (*hits)++;
+            *off = fmax(*off, fabs(cs[i].normal_velocity - v));
+        }
+    return c;
+}
+
 /* The counters of the last of `steps` steps of one block (elasticity e, its floor's too, at height y,
  * sliding at vx) on the floor in `regime`. 0 if the world could not be made. */
 static int one_block(lc_regime regime, double e, double y, double vx, int steps, lc_counters *c)
@@ -281,32 +302,22 @@ static void moreau_jean_substep(double e, double speed)
     lc_counters c;
     lc_vec2 down = {0.0, 0.0};
     lc_energy e0, e1;
-    const lc_contact *cs;
-    double y0[3], vmax = 0.0, moved = 0.0, v_hit = 0.0, v_off = 0.0;
-    int i, nc, hits = 0;
+    double y0[3], vmax = 0.0, moved = 0.0, v_off = 0.0;
+    int i, hits = 0;
     if (!w) return;
     for (i = 0; i < 3; ++i) ids[i] = block(w, 0.0, 0.25 + 0.5 * i, 0.0, e);
     run(w, 60);
     down.y = -speed;
     CHECK(lc_body_set_velocity(w, ids[2], down, 0.0) == LC_OK, "%s", "set the top block moving");
     for (i = 0; i < 3; ++i) y0[i] = sc_row(w, ids[i])[1];
-    lc_world_get_energy(w, &e0);
-    c = run(w, 1);
-    lc_world_get_energy(w, &e1);
-    lc_world_get_contacts(w, &cs, &nc);
-    for (i = 0; i < nc; ++i)
-        if (cs[i].kind == LC_CONTACT_COLLISION) {
-            hits++;
-            v_hit = cs[i].normal_velocity;
-            v_off = fmax(v_off, fabs(v_hit + speed));
-        }
+    c = one_step(w, -speed, &e0, &e1, &hits, &v_off);
     for (i = 0; i < 3; ++i) {
         if (i < 2 || e == 0.0) vmax = fmax(vmax, hypot(sc_row(w, ids[i])[3], sc_row(w, ids[i])[4]));
         if (i < 2 || e == 0.0) moved = fmax(moved, fabs(sc_row(w, ids[i])[1] - y0[i]));
     }
-    printf("moreau-jean e %.1f at %g m/s: contact islands %llu, impulse solves %llu, collisions %d at %.12f m/s, top vy %.12f, "
-           "others |v| %.3g, moved %.3g m, energy %.12f J\n", e, speed, (unsigned long long)c.contact_islands,
-           (unsigned long long)c.impulse_solves, hits, v_hit, sc_row(w, ids[2])[4], vmax, moved, e1.total - e0.total);
+    printf("moreau-jean e %.1f at %g m/s: contact islands %llu, impulse solves %llu, collisions %d (off by %.3g m/s), "
+           "top vy %.12f, others |v| %.3g, moved %.3g m, energy %.12f J\n", e, speed, (unsigned long long)c.contact_islands,
+           (unsigned long long)c.impulse_solves, hits, v_off, sc_row(w, ids[2])[4], vmax, moved, e1.total - e0.total);
     CHECK(c.contact_islands == 1, "the stack is one contact-regime island (%llu)", (unsigned long long)c.contact_islands);
     if (speed < 1e-4) {
         CHECK(c.impulse_solves == 0, "an approach slower than resting_speed takes no impact solve (%llu)",
@@ -340,21 +351,15 @@ static void moreau_jean_arrival(void)
     lc_world *w = world_with_floor(LC_REGIME_AUTO, 0.5);
     lc_body_id ids[4];
     lc_counters c;
-    const lc_contact *cs;
+    lc_energy e0, e1;
     double v_off = 0.0;
-    int i, nc, hits = 0;
+    int i, hits = 0;
     if (!w) return;
     for (i = 0; i < 3; ++i) ids[i] = block(w, 0.0, 0.25 + 0.5 * i, 0.0, 0.5);
     run(w, 60);
     ids[3] = sc_box(w, 1.0, 0.5, 0.0, 1.75 + 0.02, 0.0, 0.0, -3.0, 0.0, 1.0, 0.5);
     lc_body_set_material(w, ids[3], 0.5, 0.5);
-    c = run(w, 1);
-    lc_world_get_contacts(w, &cs, &nc);
-    for (i = 0; i < nc; ++i)
-        if (cs[i].kind == LC_CONTACT_COLLISION) {
-            hits++;
-            v_off = fmax(v_off, fabs(cs[i].normal_velocity + 3.0));
-        }
+    c = one_step(w, -3.0, &e0, &e1, &hits, &v_off);
     printf("moreau-jean arrival: contact islands %llu, collisions %d (off by %.3g m/s), vy %.12f\n",
            (unsigned long long)c.contact_islands, hits, v_off, sc_row(w, ids[3])[4]);
     CHECK(c.contact_islands == 1, "the falling block and the stack are one contact-regime island (%llu)",
@@ -376,24 +381,15 @@ static void pile_substep_bounce(void)
     lc_body_id ids[21], drop;
     lc_counters c;
     lc_energy e0, e1;
-    const lc_contact *cs;
     double v_off = 0.0, rel;
-    int i, nc, hits = 0;
+    int hits = 0;
     if (!w) return;
     sc_pyramid(w, 6, 0.5, ids);
     lc_body_set_material(w, ids[20], 0.5, 0.5);
     run(w, 60);
     drop = sc_box(w, 1.0, 0.5, 0.0, 6.0 + 0.25 + 0.02, 0.0, 0.0, -3.0, 0.0, 1.0, 0.5);
     lc_body_set_material(w, drop, 0.5, 0.5);
-    lc_world_get_energy(w, &e0);
-    c = run(w, 1);
-    lc_world_get_energy(w, &e1);
-    lc_world_get_contacts(w, &cs, &nc);
-    for (i = 0; i < nc; ++i)
-        if (cs[i].kind == LC_CONTACT_COLLISION) {
-            hits++;
-            v_off = fmax(v_off, fabs(cs[i].normal_velocity + 3.0));
-        }
+    c = one_step(w, -3.0, &e0, &e1, &hits, &v_off);
     rel = sc_row(w, drop)[4] - sc_row(w, ids[20])[4];
     printf("pile sub-step bounce: contact islands %llu, impulse solves %llu, collisions %d (off by %.3g m/s), "
            "leaves at %.12f m/s, residual %.3g m/s, energy %.6f -> %.6f J\n",
