@@ -78,6 +78,7 @@ int lc_world_reserve(lc_world *w, int bodies, lc_body_id id) { return reserve_bo
 lc_status lc_world_add_body(lc_world *w, const lc_body_def *d, lc_body_id *out_id)
 {
     lc_shape shape;
+    lc_vec2 store[2 * LC_MAX_POLYGON_VERTICES];
     char why[160];
     lc_status s;
     int row;
@@ -101,7 +102,7 @@ lc_status lc_world_add_body(lc_world *w, const lc_body_def *d, lc_body_id *out_i
     LC_CHECK_RANGE(w, d->friction, 0.0, 10.0, "friction");
     if (d->custom_center_of_mass != 0 && d->custom_center_of_mass != 1)
         return lc_fail(w, LC_ERR_OUT_OF_RANGE, "custom_center_of_mass = %d is 0 (the centroid) or 1", d->custom_center_of_mass);
-    s = lc_shape_build(&shape, d->vertices, d->vertex_count, d->custom_center_of_mass ? &d->center_of_mass : NULL,
+    s = lc_shape_build(&shape, store, d->vertices, d->vertex_count, d->custom_center_of_mass ? &d->center_of_mass : NULL,
                        why, sizeof why);
     if (s != LC_OK) return lc_fail(w, s, "%s", why);
     if (d->type == LC_BODY_DYNAMIC && d->inertia != 0.0) {
@@ -109,7 +110,7 @@ lc_status lc_world_add_body(lc_world *w, const lc_body_def *d, lc_body_id *out_i
         shape.inertia_per_mass = d->inertia / d->mass;
     }
     if (w->next_body_id == LC_WORLD_ANCHOR) return lc_fail(w, LC_ERR_OUT_OF_RANGE, "body ids exhausted");
-    if (!reserve_bodies(w, w->count + 1) || !reserve_id(w, w->next_body_id))
+    if (!reserve_bodies(w, w->count + 1) || !reserve_id(w, w->next_body_id) || lc_shape_keep(&shape, shape.count) != 0)
         return lc_fail(w, LC_ERR_NO_MEMORY, "out of memory adding a body");
     row = w->count++;
     w->edits++;
@@ -208,6 +209,7 @@ lc_status lc_world_remove_body(lc_world *w, lc_body_id id)
     row = lc_world_body_index(w, id);
     if (row < 0) return lc_fail(w, LC_ERR_UNKNOWN_BODY, "no body with id %u", (unsigned)id);
     n = w->count - row - 1;
+    lc_shape_release(&w->shape[row]);
     /* shift rows down to keep insertion order (deterministic and what callers index by) */
 #define SHIFT(arr, k) memmove(&(arr)[(size_t)row * (k)], &(arr)[(size_t)(row + 1) * (k)], (size_t)n * (k) * sizeof *(arr))
     SHIFT(w->ids, 1); SHIFT(w->mass, 1); SHIFT(w->inertia, 1); SHIFT(w->inv_mass, 1); SHIFT(w->inv_inertia, 1);

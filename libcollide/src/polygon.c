@@ -2,12 +2,14 @@
  * centroid or about a given centre of mass. */
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include "world.h"
 
 static const double LC_PI = 3.14159265358979323846;
 
-lc_status lc_shape_build(lc_shape *out, const lc_vec2 *v, int count, const lc_vec2 *center, char *why, size_t why_len)
+lc_status lc_shape_build(lc_shape *out, lc_vec2 *store, const lc_vec2 *v, int count, const lc_vec2 *center, char *why,
+                         size_t why_len)
 {
     lc_vec2 p[LC_MAX_POLYGON_VERTICES];
     double area2 = 0.0, cx = 0.0, cy = 0.0, scale = 0.0, j = 0.0, ox, oy;
@@ -107,6 +109,8 @@ lc_status lc_shape_build(lc_shape *out, const lc_vec2 *v, int count, const lc_ve
     }
     memset(out, 0, sizeof *out);
     out->count = count;
+    out->v = store;
+    out->n = store + count;
     out->center_offset = lc_v(ox, oy);
     out->area = area2 / 2.0;
     for (i = 0; i < count; ++i) out->v[i] = lc_v(p[i].x - ox, p[i].y - oy);
@@ -126,6 +130,23 @@ lc_status lc_shape_build(lc_shape *out, const lc_vec2 *v, int count, const lc_ve
     out->inertia_per_mass = out->unit_inertia;
     (void)sign;
     return LC_OK;
+}
+
+int lc_shape_keep(lc_shape *s, int count)
+{
+    lc_vec2 *block = malloc((size_t)(count > 0 ? 2 * count : 1) * sizeof *block);
+    if (block == NULL) return -1;
+    if (s->v != NULL) memcpy(block, s->v, (size_t)count * sizeof *block);
+    if (s->n != NULL) memcpy(block + count, s->n, (size_t)count * sizeof *block);
+    s->v = block;
+    s->n = block + count;
+    return 0;
+}
+
+void lc_shape_release(lc_shape *s)
+{
+    free(s->v);
+    s->v = s->n = NULL;
 }
 
 lc_status lc_make_rectangle(double width, double height, lc_vec2 out[4])

@@ -268,8 +268,12 @@ static int get_body(lc_reader *in, lc_world *w, int i)
     lc_shape *s = &w->shape[i];
     lc_trig *tr = &w->trig[i];
     int k;
-    lc_body_id id = lc_get_u32(in);
-    unsigned flag = lc_get_u8(in);
+    lc_body_id id;
+    unsigned flag;
+    /* the row counts as read whatever fails below (the caller's w->count), so its shape owns no block yet */
+    s->v = s->n = NULL;
+    id = lc_get_u32(in);
+    flag = lc_get_u8(in);
     if (in->bad) return 0;
     /* rows are in insertion order, so ids increase along them */
     if (id <= (i > 0 ? w->ids[i - 1] : 0) || id >= w->next_body_id || id > LC_SNAPSHOT_MAX_ID)
@@ -295,6 +299,7 @@ static int get_body(lc_reader *in, lc_world *w, int i)
     w->rests_dissipative[i] = (uint8_t)flag;
     memset(s, 0, sizeof *s);
     s->count = lc_get_count(in, 3, LC_MAX_POLYGON_VERTICES, 32, "a polygon's vertex count");
+    if (lc_shape_keep(s, s->count) != 0) return -1;
     for (k = 0; k < s->count; ++k) {
         s->v[k].x = lc_get_finite(in, "a vertex");
         s->v[k].y = lc_get_finite(in, "a vertex");

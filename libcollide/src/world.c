@@ -245,7 +245,9 @@ lc_world *lc_world_create(const lc_world_def *def, char *errbuf, size_t errbuf_l
 
 void lc_world_destroy(lc_world *w)
 {
+    int i;
     if (w == NULL) return;
+    for (i = 0; i < w->count; ++i) lc_shape_release(&w->shape[i]);
     free(w->ids); free(w->state); free(w->mass); free(w->inertia); free(w->inv_mass); free(w->inv_inertia);
     free(w->is_static); free(w->elasticity); free(w->friction); free(w->ext_force); free(w->ext_torque);
     free(w->shape); free(w->trig); free(w->thrusters); free(w->thruster_count); free(w->id_to_row);

@@ -18,11 +18,14 @@ typedef struct lc_thruster {
     double level;
 } lc_thruster;
 
-/* Shape and material of one body; vertices are relative to the centre of mass. */
+/* Shape of one body; vertices are relative to the centre of mass. The vertices and normals live in a
+ * block of their own (lc_shape_keep), not in arrays of the polygon limit: at 64 vertices a row took 2 KB,
+ * and the hot loops that read a box's four corners for every body (its bounding box, the vertex-in-body
+ * tests) then touched a new page per body; 20 000 bodies in free flight took ~30 % longer per step. */
 typedef struct lc_shape {
     int count;
-    lc_vec2 v[LC_MAX_POLYGON_VERTICES];
-    lc_vec2 n[LC_MAX_POLYGON_VERTICES];   /* outward unit normal of edge v[i] -> v[i+1] */
+    lc_vec2 *v;                           /* count vertices, counter-clockwise */
+    lc_vec2 *n;                           /* outward unit normal of edge v[i] -> v[i+1] (same block as v) */
     lc_vec2 center_offset;                /* local-frame origin -> centre of mass, body frame */
     double radius;                        /* max |v[i]| */
     double min_edge;                      /* length of the shortest edge */
@@ -187,8 +190,15 @@ void lc_remove_springs_of(lc_world *w, lc_body_id id);
 
 /* ---- polygon.c ---- */
 /* Validates a polygon and builds its shape about `center` (local frame; NULL: the centroid), which must
- * lie in the polygon. On failure returns the status and writes the reason into why. */
-lc_status lc_shape_build(lc_shape *out, const lc_vec2 *v, int count, const lc_vec2 *center, char *why, size_t why_len);
+ * lie in the polygon, its vertices and normals in store (2 x LC_MAX_POLYGON_VERTICES vectors, the
+ * caller's until lc_shape_keep). On failure returns the status and writes the reason into why. */
+lc_status lc_shape_build(lc_shape *out, lc_vec2 *store, const lc_vec2 *v, int count, const lc_vec2 *center, char *why,
+                         size_t why_len);
+/* Gives a shape a block of its own for count vertices and normals, copying those v and n point to when
+ * they are set (a built shape's store); 0, or -1 without memory (the shape unchanged). */
+int lc_shape_keep(lc_shape *s, int count);
+/* Frees a kept shape's block. */
+void lc_shape_release(lc_shape *s);
 
 /* ---- small vector helpers ---- */
 static inline lc_vec2 lc_v(double x, double y) { lc_vec2 r; r.x = x; r.y = y; return r; }
