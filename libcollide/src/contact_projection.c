@@ -38,14 +38,14 @@ void lc_contact_projection_destroy(lc_contact_projection *cp)
 /* The projection by MPRGP (sparse_lcp.c, conjugate gradients with bound projections), when Gauss-Seidel
  * did not converge: it needs sweeps in the square of a chain's length (a block pushing a row of twenty
  * boxes left the row overlapping after 400), MPRGP products in its length. left: the deepest overlap the
- * pass starts from. A pass of at least LC_CONTACT_PROJECTION_LARGE points starts from the sweeps' answer
- * (in rows) and stops near the overlap it starts from (tunables.h); a smaller one starts from zero and
- * solves to the island's slack. The displacements land in b.disp. */
+ * pass starts from. A pass of at least LC_CONTACT_PROJECTION_LARGE points, or of a pile sub-step, starts
+ * from the sweeps' answer (in rows) and stops near the overlap it starts from (tunables.h); another one
+ * starts from zero and solves to the island's slack. The displacements land in b.disp. */
 static int project_by_mprgp(lc_contact_projection *cp, lc_contact_island *c, const lc_touch *t, int nt, double gp, double left, lc_contact_row *rows)
 {
     lc_world *w = c->w;
     double *v = lc_buf_get(&cp->b_mprgp, (size_t)nt * 4 * sizeof(double)), *b, *lo, *hi, viol, tol;
-    int i, large = nt >= LC_CONTACT_PROJECTION_LARGE;
+    int i, large = nt >= LC_CONTACT_PROJECTION_LARGE || c->pile;
     if (v == NULL) return -1;
     b = v + nt;
     lo = b + nt;

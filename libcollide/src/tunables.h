@@ -151,8 +151,8 @@
  * approaches) cannot converge either and only triple the sweeps, and projecting the overlaps those
  * velocities leave (1e-4 m a step) to 4e-10 m took two passes of 50 sweeps. Instructions per step
  * (callgrind, 300 steps of bench/contact.py's scenes) against the trapezoidal path: 100 mixed boxes -29,
- * -40 and -34 % over three seeds, a box dropped on a base-12 pyramid -33 %, the block pushing a row of
- * 40 -18 %, the base-20 pyramid -9 %. Islands of LC_CONTACT_LARGE_ISLAND_BODIES bodies or more keep the
+ * -40 and -32 % over three seeds, a box dropped on a base-12 pyramid -41 %, the block pushing a row of
+ * 40 -11 %, the base-20 pyramid -8 % (with the projection's start of LC_CONTACT_PROJECTION_LARGE). Islands of LC_CONTACT_LARGE_ISLAND_BODIES bodies or more keep the
  * trapezoidal path: a velocity error moves positions twice as far under x += h v, and the settled
  * 1 000-box pile's projection (active sets and MPRGP) then took +23 % of a step. Fewer bodies than this
  * (a few polygons with many vertices) converge, and keep the exact impacts and the 4e-10 m slack. */
@@ -232,16 +232,20 @@
 #define LC_CONTACT_PROJECTION_GAIN 1e-2
 #endif
 #define LC_CONTACT_PROJECTION_PRODUCTS 2000
-/* A projection pass of at least LC_CONTACT_PROJECTION_LARGE points that Gauss-Seidel did not converge
- * starts MPRGP from the sweeps' answer and stops it within LC_CONTACT_PROJECTION_PASS_TOLERANCE of the
+/* A projection pass of at least LC_CONTACT_PROJECTION_LARGE points, or of a pile sub-step
+ * (LC_CONTACT_PILE_BODIES), that Gauss-Seidel did not converge starts MPRGP from the sweeps' answer and stops it within LC_CONTACT_PROJECTION_PASS_TOLERANCE of the
  * overlap the pass starts from (or at LC_CONTACT_PROJECTION_SLACK, the larger): the linearised gaps a
  * pass solves are off by the rotation's second-order remainder, ~overlap^2 / size (3e-3 of a
  * millimetre's overlap on a 0.3 m box), which the next pass removes together with the solve's own
  * error. A settling 1 000-box pile ends its flow a millimetre deep every step (Gauss-Seidel stalls in
  * its 25 layers); its passes took the 2 000-product budget and 600 more to reach 4e-10 m from zero.
- * Smaller passes start from zero and keep the absolute stop: their products are cheap, and either
- * change moved which steps of a box dropped on a base-12 pyramid needed their precise retry, one of
- * them then keeping a gain above 1e-9 of the energy (bench/contact.py drop12). */
+ * A pile sub-step's velocities move its bodies into each other by x += h v: 1 000 boxes landing in a box
+ * form islands of 16-299 bodies whose passes, from zero to the slack, took MPRGP 3.5 times the
+ * instructions (callgrind, steps 50-100 of bench/contact.py's mixed1000, +58 % a step); from the sweeps'
+ * answer the step costs what the trapezoidal path's did, and the box dropped on a base-12 pyramid takes
+ * 12 % fewer instructions with no step kept unresolved. Other passes start from zero and keep the
+ * absolute stop: their products are cheap, and either change moved which steps of that drop needed their
+ * precise retry under the trapezoidal path, one of them then keeping a gain above 1e-9 of the energy. */
 #define LC_CONTACT_PROJECTION_PASS_TOLERANCE 1e-3
 #define LC_CONTACT_PROJECTION_LARGE 1000
 /* A projection pass of at least this many points starts from active sets over a sparse factorization
