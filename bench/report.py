@@ -812,8 +812,9 @@ def contact_notes(sec: dict[str, Any]) -> list[str]:
     if seeded:
         seeds_text = (f"Random piles ({', '.join(seeded)}; seeds in the scene cell): each engine runs every seed in "
                       "the same run, the engines interleaved within a seed; µs/step is the median over the seeds "
-                      "of each seed's median, libcollide / peer the ratio of the two medians in the row (not the "
-                      "median of the seeds' ratios, listed below), and every quality column the worst seed's "
+                      "of each seed's median, libcollide / peer the median of the seeds' own ratios (listed below: "
+                      "each compares the engines on the same pile), not the quotient of the row's two medians, and "
+                      "every quality column the worst seed's "
                       "(largest overlap, most escapes, largest gain; ', seed N' names it), a run that did not "
                       "finish the worst seed's status. ")
     L = ["Legend: µs/step = CPU time of the step loop per 1/60 s step, median over "
