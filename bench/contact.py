@@ -8,8 +8,9 @@ engine on the same ones, the engines interleaved within each seed: one pile's ch
 moves libcollide's cost by 20-30 %. Their row (aggregate_seeds) gives each engine's CPU per step as
 the median over the seeds, libcollide / peer as the median over the seeds of each seed's ratio (both
 engines on the same pile: the ratio of the two medians can pair one engine's seed with the other's),
-and every quality measure as the worst seed's; each seed's row stays in the JSON under per_seed. Default seeds 1, 2, 3
-(--seeds); with --quick mixed1000 runs the first seed only (~10 s of libcollide CPU per seed).
+and every quality measure as the worst seed's; each seed's row stays in the JSON under per_seed.
+Default seeds 1, 2, 3 (--seeds); with --quick mixed1000 runs the first seed only (~10 s of libcollide
+CPU per seed).
 
 Developer entry (prints the table, touches nothing in docs/):
 
@@ -345,8 +346,8 @@ def main() -> int:
         sec = run_section(pool, keys, engines, args.repeats, args.budget, log, seeds, args.quick)
     finally:
         pool.close()
-    import report
-    print("\n".join(report.contact_table(sec) + [""] + report.contact_notes(sec)))
+    import report_contact
+    print("\n".join(report_contact.contact_table(sec) + [""] + report_contact.contact_notes(sec)))
     if args.json:
         import json
         with open(args.json, "w") as fh:

@@ -28,6 +28,7 @@ import contact  # noqa: E402
 import harness  # noqa: E402
 import metrics  # noqa: E402
 import report  # noqa: E402
+import report_contact  # noqa: E402
 import scenes  # noqa: E402
 from harness import Task  # noqa: E402
 
@@ -357,7 +358,7 @@ class Bench:
         random piles run on --seeds (default 1,2,3; --quick: mixed1000 on the first only) and report
         medians over the seeds (bench/contact.py)."""
         budget = self.args.budget or (contact.BUDGET_QUICK if self.quick else contact.BUDGET_DEFAULT)
-        seeds = contact.parse_seeds(self.args.seeds) if self.args.seeds else contact.SEEDS
+        seeds = self.args.seeds or contact.SEEDS
         self.out["contact"] = contact.run_section(self.pool, list(contact.SCENE_KEYS), contact.ENGINES,
                                                   self.repeats, budget, log, seeds, self.quick)
 
@@ -381,7 +382,7 @@ def main() -> int:
     ap.add_argument("--engines", help="comma list of engines for the scaling section (default: all; libcollide always)")
     args = ap.parse_args()
     if args.seeds:
-        contact.parse_seeds(args.seeds)   # a bad list stops here, not after the sections before contact
+        args.seeds = contact.parse_seeds(args.seeds)   # a bad list stops here, not after the sections before contact
     t0 = time.time()
     b = Bench(args)
     import importlib.metadata as md
@@ -408,7 +409,7 @@ def main() -> int:
             # (python bench/report.py --replot redraws them from it)
             save_results(b.out, os.path.splitext(os.path.basename(args.out))[0] + ".json")
         if "contact" in b.out:   # a page of its own: report.write rewrites the whole of args.out
-            report.write_contact(b.out, os.path.join(docs, "bench_contact.md"))
+            report_contact.write_contact(b.out, os.path.join(docs, "bench_contact.md"))
             log(f"wrote {os.path.join(docs, 'bench_contact.md')}")
             save_results(b.out, "bench_contact.json")
     log(f"done in {time.time() - t0:.0f} s")

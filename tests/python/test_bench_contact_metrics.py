@@ -1,5 +1,5 @@
 """The contact section's quality measures (bench/metrics.py) on states made by hand, and how
-bench/contact.py and bench/report.py turn a run that stopped early into a row and a table cell.
+bench/contact.py and bench/report_contact.py turn a run that stopped early into a row and a table cell.
 
 The overlap depth must be the true penetration depth of two rectangles (the shortest separating
 translation), whatever their angles: the section ranks engines by it, so a measure that misses a
@@ -234,7 +234,7 @@ def test_a_run_over_budget_keeps_its_steps_cpu_and_quality(contact: ModuleType) 
                                     "steps_done": 5, "cpu_done": 2.0, "states": states[:6]})
     assert killed["kind"] == "over budget" and killed["killed_in_step"] and math.isclose(killed["us_per_step"], 4e5)
 
-    report = _load("report")
+    report = _load("report_contact")
     sec = {"engines": ["libcollide", "box2d3"], "rows": [lc, peer], "repeats": 1, "dt": 1 / 60,
            "settings": contact.CONTACT_SETTINGS, "budget_cpu_s": 20.0, "peer_budget_cpu_s": 600.0,
            "scenes": {"stack10": {"name": cs.scene.name, "what": cs.what, "bodies": 10, "steps": 600,
@@ -282,7 +282,7 @@ def test_random_piles_take_the_median_cost_and_the_worst_quality_over_seeds(cont
     assert agg["e_change"] == -0.5 and agg["stages"] == {"steps": 641, "collisions": 6}
     assert rows[1]["kind"] == "ok" and rows[1]["max_overlap"] == 0.0
 
-    report = _load("report")
+    report = _load("report_contact")
     sec = {"engines": ["libcollide", "box2d3"], "rows": rows, "repeats": 1, "dt": 1 / 60,
            "settings": contact.CONTACT_SETTINGS, "budget_cpu_s": 20.0, "peer_budget_cpu_s": 600.0,
            "scenes": {"mixed30": {"name": "mixed30_s1, mixed30_s2, mixed30_s3", "what": "pile", "bodies": 30,
