@@ -6,6 +6,7 @@
  *   sc_box(w, width, height, x, y, angle, vx, vy, omega, mass, e)  - add a dynamic w x h rectangle
  *   sc_static_box(w, width, height, x, y, e)                      - add a static rectangle
  *   sc_pyramid(w, base, mu, ids)       - Box2D's large-pyramid layout of unit boxes (no ground)
+ *   sc_drop_on_pyramid(base)           - the contact bench's drop12 world: a 5 kg box at 8 m/s onto a pyramid
  *   sc_poly(w, verts, n, x, y, angle, mass)                        - add a dynamic polygon
  *   sc_row(w, id)                      - pointer to a body's 6 state doubles (x, y, angle, vx, vy, omega)
  *   sc_mass(w, id), sc_inertia(w, id)
@@ -118,6 +119,28 @@ static inline int sc_pyramid(lc_world *w, int base, double mu, lc_body_id *ids)
             n++;
         }
     return n;
+}
+
+/* bench/contact.py's drop12 (bench/scenes.py drop_on_pyramid): a new world (g 10 down, no damping) with
+ * sc_pyramid(base) (mu 0.6, e 0), a static ground 2 base + 20 m x 1 m (top face y = 0, mu 0.6, e 0), then
+ * a 5 kg unit box from 2 m above the top at 8 m/s down, turning at 1 rad/s (mu 0.6, e 0): the bench's
+ * bodies in the bench's order, so its trajectory step for step. NULL if the world could not be made. */
+static inline lc_world *sc_drop_on_pyramid(int base)
+{
+    lc_world_def d = lc_default_world_def();
+    lc_world *w;
+    lc_body_id id;
+    d.gravity.x = 0.0;
+    d.gravity.y = -10.0;
+    d.damping = 0.0;
+    w = sc_world(&d);
+    if (!w) return NULL;
+    sc_pyramid(w, base, 0.6, NULL);
+    id = sc_static_box(w, 2.0 * base + 20.0, 1.0, 0.0, -0.5, 0.0);
+    CHECK(lc_body_set_material(w, id, 0.0, 0.6) == LC_OK, "%s", "ground material");
+    id = sc_box(w, 1.0, 1.0, 0.3, base + 2.0, 0.0, 0.0, -8.0, 1.0, 5.0, 0.0);
+    CHECK(lc_body_set_material(w, id, 0.0, 0.6) == LC_OK, "%s", "box material");
+    return w;
 }
 
 static inline lc_body_id sc_poly(lc_world *w, const lc_vec2 *verts, int n, double x, double y, double angle,

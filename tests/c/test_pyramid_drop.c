@@ -16,12 +16,10 @@
 
 #define BASE 12
 #define STEPS 160
-#define MU 0.6
 #define GAIN_TOL 1e-9
 
 int main(void)
 {
-    lc_world_def d = lc_default_world_def();
     const double box[4] = {-30.0, -1.0, 30.0, 40.0};
     lc_world *w;
     lc_counters tot;
@@ -29,14 +27,8 @@ int main(void)
     double e_prev, worst = -INFINITY, t_worst = 0.0;
     hc_mon m;
     int k;
-    d.gravity.x = 0.0;
-    d.gravity.y = -10.0;
-    d.damping = 0.0;
-    w = sc_world(&d);
+    w = sc_drop_on_pyramid(BASE);
     if (!w) return CHECK_SUMMARY("test_pyramid_drop");
-    sc_pyramid(w, BASE, MU, NULL);
-    hc_static(w, 2.0 * BASE + 20.0, 1.0, 0.0, -0.5, 0.0, MU);
-    hc_box(w, 1.0, 1.0, 0.3, BASE + 2.0, 0.0, 0.0, -8.0, 1.0, 5.0, 0.0, MU);
     if (!hc_mon_init(&m, w, "drop on a base-12 pyramid", 1.0 / 60.0, box)) return CHECK_SUMMARY("test_pyramid_drop");
     m.overlap_tol = HC_PILE_OVERLAP_TOL;
     CHECK(lc_world_get_energy(w, &en) == LC_OK, "%s", "energy");
