@@ -95,6 +95,8 @@ int lc_contact_project(lc_contact_projection *cp, lc_contact_island *c, lc_buf *
     double gp = fmin(LC_CONTACT_PROJECTION_GAP, 1e-3 * w->def.contact_gap), reach = 0.0;
     double *margin = lc_buf_get(margins, (size_t)(c->isl->npairs > 0 ? c->isl->npairs : 1) * sizeof(double));
     int pass, i, k, nt = 0;
+    /* the overlap that starts a pass: the slack, twice that with the large slack (tunables.h) */
+    double trigger = c->slack == LC_CONTACT_PROJECTION_LARGE_SLACK ? LC_CONTACT_PROJECTION_LARGE_TRIGGER : c->slack;
     if (margin == NULL) return -1;
     for (pass = 0;; ++pass) {
         lc_touch *t;
@@ -108,7 +110,7 @@ int lc_contact_project(lc_contact_projection *cp, lc_contact_island *c, lc_buf *
         t = (lc_touch *)end->p;
         *left = 0.0;
         for (i = 0; i < nt; ++i)
-            if (t[i].gap < -c->slack) {
+            if (t[i].gap < -trigger) {
                 any = 1;
                 *left = fmax(*left, -t[i].gap);
             }

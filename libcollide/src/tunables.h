@@ -211,6 +211,16 @@
  * scenes are held to (bench/contact.py), and 1e-6 m of lift is 1e-5 J per kilogram at g. */
 #define LC_CONTACT_PROJECTION_LARGE_SLACK 1e-7
 #define LC_CONTACT_LARGE_ISLAND_BODIES 300
+/* m, the overlap that starts a projection pass where the slack is LC_CONTACT_PROJECTION_LARGE_SLACK:
+ * twice it. A pass stopped at the slack leaves its worst point a little past it (the rotation's
+ * second-order remainder and the solve's own error, 1e-7 to 2e-6 m in a pile of 100 boxes), and a pass for
+ * that one point sweeps the whole island again (10-25 sweeps of its ~200 points). Starting passes at
+ * 2e-7 m keeps every step end inside LC_CONTACT_OVERLAP_LEFT's 2.5e-7 m and takes fewer instructions
+ * (callgrind, bench/contact.py's scenes over 300 steps: a box dropped on a base-12 pyramid -13 %, the
+ * block pushing a row of 40 -4 %, 100 mixed boxes -1 / +1 / -5 % on seeds 1-3, 1 000 mixed boxes -10
+ * and -6 % over 20 steps from their states at 1.7 s and 4.2 s; four times the slack took the push
+ * +27 % and left a drop step unresolved). */
+#define LC_CONTACT_PROJECTION_LARGE_TRIGGER 2e-7
 /* m, the overlap a contact-regime step may leave after its projection before the island is taken again
  * (contact_regime.c): the test suites' 1e-9 m, ten times the projection's own aim; in a large island or
  * a pile sub-step scaled with its slack (2.5e-7 m, four times inside the 1e-6 m the contact scenes are
