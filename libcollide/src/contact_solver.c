@@ -188,20 +188,33 @@ static inline double solve_row(lc_contact_row *r, double *v, const double *inv_m
     return change;
 }
 
-/* One Gauss-Seidel sweep over the rows; returns its largest change in velocity units. */
-static double sweep(lc_contact_row *rows, int nrows, double *v, const double *inv_mass, const double *inv_inertia)
+/* The squared step of a row over the sweep: its part of |lambda - lambda_prev|^2. */
+static inline double step_squared(const lc_contact_row *r)
 {
-    double change = 0.0;
+    double dn = r->lambda_n - r->prev_n, dt = r->lambda_t - r->prev_t;
+    return dn * dn + dt * dt;
+}
+
+/* One Gauss-Seidel sweep over the rows; returns its largest change in velocity units, and in *rr the
+ * squared length of its step (rows in order, as the momentum step sums it). */
+static double sweep(lc_contact_row *rows, int nrows, double *v, const double *inv_mass, const double *inv_inertia,
+                    double *rr)
+{
+    double change = 0.0, sum = 0.0;
     int i;
     for (i = 0; i < nrows; ++i) {
         lc_contact_row *r = &rows[i];
         if (r->block) {
             change = larger(change, solve_block(r, v, inv_mass, inv_inertia));
+            sum += step_squared(r);
+            sum += step_squared(r + 1);
             ++i;
         } else {
             change = larger(change, solve_row(r, v, inv_mass, inv_inertia));
+            sum += step_squared(r);
         }
     }
+    *rr = sum;
     return change;
 }
 
@@ -243,7 +256,7 @@ lc_contact_solve lc_contact_solver_run(lc_contact_row *rows, int nrows, double *
             if (!(out.residual < 0.5 * checkpoint)) break;
             checkpoint = out.residual;
         }
-        change = sweep(rows, nrows, v, inv_mass, inv_inertia);
+        change = sweep(rows, nrows, v, inv_mass, inv_inertia, &rr);
         out.sweeps = s + 1;
         out.residual = change;
         if (change <= tolerance) break;
@@ -252,10 +265,6 @@ lc_contact_solve lc_contact_solver_run(lc_contact_row *rows, int nrows, double *
          * beta = |r|^2 / |r_old|^2 (Fletcher-Reeves, restarted when it exceeds 1), carries a stack's
          * slowly converging modes along, where Gauss-Seidel alone takes sweeps in the square of its
          * height. The next sweep projects back onto the cone. */
-        for (i = 0; i < nrows; ++i) {
-            double dn = rows[i].lambda_n - rows[i].prev_n, dt = rows[i].lambda_t - rows[i].prev_t;
-            rr += dn * dn + dt * dt;
-        }
         beta = rr_old > 0.0 ? rr / rr_old : 0.0;
         if (beta > 1.0) beta = 0.0;
         for (i = 0; i < nrows; ++i) {
