@@ -63,18 +63,16 @@ static int project_by_mprgp(lc_contact_projection *cp, lc_contact_island *c, con
     return 0;
 }
 
-/* The start of a projection pass of a pile sub-step or of at least LC_CONTACT_PROJECTION_DIRECT_ROWS
- * points: active sets over a sparse factorization (projection_active_set.h) into the rows' lambda_n,
- * kept when their objective is below no push's (0). Gauss-Seidel and MPRGP need sweeps and products in
- * a pile's height (a settling 1 000-box pile: 50 sweeps and ~1 400 products a step from no push); the
- * factorizations do not, and the sweeps and MPRGP that follow finish from the start (with it, such a
- * pile's step takes about half the instructions, callgrind). A pass of fewer than
- * LC_CONTACT_PROJECTION_LARGE points keeps only a start whose set settled, and gives up on one that
- * trades places (tunables.h). 0, or -1 without memory. */
+/* The start of a projection pass of at least LC_CONTACT_PROJECTION_DIRECT_ROWS points: active sets over
+ * a sparse factorization (projection_active_set.h) into the rows' lambda_n, kept when their objective is
+ * below no push's (0). Gauss-Seidel and MPRGP need sweeps and products in a pile's height (a settling
+ * 1 000-box pile: 50 sweeps and ~1 400 products a step from no push); the factorizations do not, and the
+ * sweeps and MPRGP that follow finish from the start (with it, such a pile's step takes about half the
+ * instructions, callgrind). 0, or -1 without memory. */
 static int start_projection(lc_contact_projection *cp, lc_contact_island *c, const lc_touch *t, int nt, double gp, lc_contact_row *rows)
 {
     double *xy = lc_buf_get(&cp->b_direct, (size_t)nt * 4 * sizeof(double)), *b, *lambda, value;
-    int i, rounds, small = nt < LC_CONTACT_PROJECTION_LARGE;
+    int i;
     if (xy == NULL) return -1;
     b = xy + 2 * nt;
     lambda = b + nt;
@@ -83,10 +81,10 @@ static int start_projection(lc_contact_projection *cp, lc_contact_island *c, con
         xy[2 * i + 1] = t[i].p.y;
         b[i] = t[i].gap - gp;
     }
-    rounds = lc_projection_active_set_solve(cp->direct, rows, xy, nt, c->b.n, c->b.inv_mass, c->b.inv_inertia, b,
-                                            c->slack, small, lambda, &value);
-    if (rounds < 0) return -1;
-    if (value < 0.0 && (rounds > 0 || !small))
+    if (lc_projection_active_set_solve(cp->direct, rows, xy, nt, c->b.n, c->b.inv_mass, c->b.inv_inertia, b,
+                                       c->slack, lambda, &value) < 0)
+        return -1;
+    if (value < 0.0)
         for (i = 0; i < nt; ++i) rows[i].lambda_n = lambda[i];
     return 0;
 }
@@ -97,8 +95,6 @@ int lc_contact_project(lc_contact_projection *cp, lc_contact_island *c, lc_buf *
     double gp = fmin(LC_CONTACT_PROJECTION_GAP, 1e-3 * w->def.contact_gap), reach = 0.0;
     double *margin = lc_buf_get(margins, (size_t)(c->isl->npairs > 0 ? c->isl->npairs : 1) * sizeof(double));
     int pass, i, k, nt = 0;
-    /* the overlap that starts a pass: the slack, twice that with the large slack (tunables.h) */
-    double trigger = c->slack == LC_CONTACT_PROJECTION_LARGE_SLACK ? LC_CONTACT_PROJECTION_LARGE_TRIGGER : c->slack;
     if (margin == NULL) return -1;
     for (pass = 0;; ++pass) {
         lc_touch *t;
@@ -112,7 +108,7 @@ int lc_contact_project(lc_contact_projection *cp, lc_contact_island *c, lc_buf *
         t = (lc_touch *)end->p;
         *left = 0.0;
         for (i = 0; i < nt; ++i)
-            if (t[i].gap < -trigger) {
+            if (t[i].gap < -c->slack) {
                 any = 1;
                 *left = fmax(*left, -t[i].gap);
             }
@@ -131,7 +127,7 @@ int lc_contact_project(lc_contact_projection *cp, lc_contact_island *c, lc_buf *
             rows[i].mu = 0.0;
             rows[i].target_n = gp - t[i].gap;
         }
-        if ((c->pile || nt >= LC_CONTACT_PROJECTION_DIRECT_ROWS) && start_projection(cp, c, t, nt, gp, rows) != 0) return -1;
+        if (nt >= LC_CONTACT_PROJECTION_DIRECT_ROWS && start_projection(cp, c, t, nt, gp, rows) != 0) return -1;
         memset(c->b.disp, 0, (size_t)c->b.n * 3 * sizeof(double));
         ps = lc_contact_solver_run(rows, nt, c->b.disp, c->b.inv_mass, c->b.inv_inertia, LC_CONTACT_PROJECTION_SWEEPS,
                                    c->slack, LC_CONTACT_STALL_SWEEPS);

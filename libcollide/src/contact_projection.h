@@ -5,8 +5,8 @@
  * against gravity is energy the step did not have (a contact_gap of 1 mm made that 1e-5 J per body). The
  * touches are searched again after each pass, for at most LC_CONTACT_PROJECTION_PASSES passes: pushing
  * one pair apart can turn another into the other body. A pass is solved by Gauss-Seidel; MPRGP takes
- * over where the sweeps do not converge (a chain's length squared), and a pass of a pile sub-step or of
- * at least LC_CONTACT_PROJECTION_DIRECT_ROWS points starts from active sets over a sparse factorization
+ * over where the sweeps do not converge (a chain's length squared), and a pass of at least
+ * LC_CONTACT_PROJECTION_DIRECT_ROWS points starts from active sets over a sparse factorization
  * (projection_active_set.h). */
 #ifndef LC_CONTACT_PROJECTION_H
 #define LC_CONTACT_PROJECTION_H

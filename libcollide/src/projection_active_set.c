@@ -121,14 +121,14 @@ static int build_matrix(lc_projection_active_set *ps, const lc_contact_row *rows
 
 int lc_projection_active_set_solve(lc_projection_active_set *ps, const lc_contact_row *rows, const double *xy,
                                    int m, int nbodies, const double *inv_mass, const double *inv_inertia,
-                                   const double *b, double tol, int give_up, double *lambda, double *objective)
+                                   const double *b, double tol, double *lambda, double *objective)
 {
     size_t mm = (size_t)(m > 0 ? m : 1);
     double *vec = lc_buf_get(&ps->b_vec, mm * 3 * sizeof(double));
     double *disp = lc_buf_get(&ps->b_disp, (size_t)(nbodies > 0 ? nbodies : 1) * 3 * sizeof(double));
     unsigned char *active = lc_buf_get(&ps->b_active, mm);
     double *reg, *x, *w, value = 0.0;
-    int i, round, rounds, settled = 0, last_changes = -1;
+    int i, round, rounds, settled = 0;
     if (vec == NULL || disp == NULL || active == NULL) return -1;
     reg = vec;
     x = reg + m;
@@ -159,11 +159,6 @@ int lc_projection_active_set_solve(lc_projection_active_set *ps, const lc_contac
             }
         }
         settled = changes == 0;
-        if (!settled && give_up && last_changes >= 0 && changes >= last_changes) {
-            ++round;
-            break;
-        }
-        last_changes = changes;
     }
     rounds = round;
     /* a settled set's equations hold together: corrections through the same factor take out the raised

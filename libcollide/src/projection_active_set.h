@@ -14,8 +14,7 @@
  * What it is for. Gauss-Seidel and MPRGP need sweeps and products in the height of a pile (cond A ~
  * n^2); a factorization of a planar contact graph costs O(m^1.5) whatever the height. In a pile the set
  * rarely settles (dependent rows trade places), so the rounds' answer is a start: the caller's sweeps
- * and MPRGP finish the projection from it, and take it only when it scores below no push (below
- * LC_CONTACT_PROJECTION_LARGE points, only when it settled: contact_projection.c). */
+ * and MPRGP finish the projection from it, and take it only when it scores below no push. */
 #ifndef LC_PROJECTION_ACTIVE_SET_H
 #define LC_PROJECTION_ACTIVE_SET_H
 
@@ -29,12 +28,11 @@ void lc_projection_active_set_destroy(lc_projection_active_set *ps);
 /* rows[0..m): the rows' bodies (indices < nbodies, -1 static), directions and lever arms; xy[2i..2i+1]
  * row i's point (for the ordering); b the rows' constants (m). Out: lambda (m), the last round's answer
  * with its negative parts dropped, and *objective, its value of 1/2 lambda' A lambda + b' lambda (the
- * problem's minimum over lambda >= 0 is the answer; no push scores 0). give_up: stop at the first
- * round that changes no fewer rows than the round before (a set that trades places, as dependent rows
- * do, does not settle in the rounds left). Returns the rounds taken when the set settled (>= 1), 0
- * when it did not within LC_PROJECTION_ACTIVE_SET_ROUNDS (or gave up), or -1 without memory. */
+ * problem's minimum over lambda >= 0 is the answer; no push scores 0). Returns the
+ * rounds taken when the set settled (>= 1), 0 when it did not within LC_PROJECTION_ACTIVE_SET_ROUNDS,
+ * or -1 without memory. */
 int lc_projection_active_set_solve(lc_projection_active_set *ps, const lc_contact_row *rows, const double *xy,
                                    int m, int nbodies, const double *inv_mass, const double *inv_inertia,
-                                   const double *b, double tol, int give_up, double *lambda, double *objective);
+                                   const double *b, double tol, double *lambda, double *objective);
 
 #endif

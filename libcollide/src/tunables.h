@@ -211,16 +211,6 @@
  * scenes are held to (bench/contact.py), and 1e-6 m of lift is 1e-5 J per kilogram at g. */
 #define LC_CONTACT_PROJECTION_LARGE_SLACK 1e-7
 #define LC_CONTACT_LARGE_ISLAND_BODIES 300
-/* m, the overlap that starts a projection pass where the slack is LC_CONTACT_PROJECTION_LARGE_SLACK:
- * twice it. A pass stopped at the slack leaves its worst point a little past it (the rotation's
- * second-order remainder and the solve's own error, 1e-7 to 2e-6 m in a pile of 100 boxes), and a pass for
- * that one point sweeps the whole island again (10-25 sweeps of its ~200 points). Starting passes at
- * 2e-7 m keeps every step end inside LC_CONTACT_OVERLAP_LEFT's 2.5e-7 m and takes fewer instructions
- * (callgrind, bench/contact.py's scenes over 300 steps: a box dropped on a base-12 pyramid -13 %, the
- * block pushing a row of 40 -4 %, 100 mixed boxes -1 / +1 / -5 % on seeds 1-3, 1 000 mixed boxes -10
- * and -6 % over 20 steps from their states at 1.7 s and 4.2 s; four times the slack took the push
- * +27 % and left a drop step unresolved). */
-#define LC_CONTACT_PROJECTION_LARGE_TRIGGER 2e-7
 /* m, the overlap a contact-regime step may leave after its projection before the island is taken again
  * (contact_regime.c): the test suites' 1e-9 m, ten times the projection's own aim; in a large island or
  * a pile sub-step scaled with its slack (2.5e-7 m, four times inside the 1e-6 m the contact scenes are
@@ -258,18 +248,10 @@
  * precise retry under the trapezoidal path, one of them then keeping a gain above 1e-9 of the energy. */
 #define LC_CONTACT_PROJECTION_PASS_TOLERANCE 1e-3
 #define LC_CONTACT_PROJECTION_LARGE 1000
-/* A projection pass of at least this many points, or of a pile sub-step (LC_CONTACT_PILE_BODIES), starts
- * from active sets over a sparse factorization (projection_active_set.h), whose cost does not grow with
- * a pile's height; other passes start from no push, where the sweeps usually converge and cost less.
- * In a moving pile the set settles in 4-6 rounds and the sweeps that follow stop after one: a pass of
- * 100 mixed boxes took 50-75 sweeps from no push. Below LC_CONTACT_PROJECTION_LARGE points a start
- * whose set did not settle is not kept, and the rounds stop once they change no fewer rows than the
- * round before: a pyramid's dependent rows trade places (160 of its 180 held rows a round), and keeping
- * such a start moved which steps of a box dropped on a base-12 pyramid needed a precise retry, three of
- * them then kept unresolved. Instructions per step with pile passes started this way (callgrind, 300
- * steps of bench/contact.py's scenes): 100 mixed boxes -19 / -11 / -10 % on seeds 1-3, the push -5 %,
- * 1 000 mixed boxes -5 % over 20 steps from 0.8 s (the same bits from 1.7 s and 4.2 s), the drop on the
- * pyramid +5 % (its rounds given up). */
+/* A projection pass of at least this many points starts from active sets over a sparse factorization
+ * (projection_active_set.h), whose cost does not grow with a pile's height; below it the sweeps usually
+ * converge and cost less (from 256 points up, a box dropped on a base-12 pyramid took 20 % more
+ * instructions and one step kept an energy gain of 1.2e-9, bench/contact.py drop12). */
 #ifndef LC_CONTACT_PROJECTION_DIRECT_ROWS   /* -D to measure */
 #define LC_CONTACT_PROJECTION_DIRECT_ROWS 1000
 #endif

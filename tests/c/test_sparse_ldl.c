@@ -281,7 +281,7 @@ static void check_column(void)
             b[p.m - 1] = -1e-3;
         }
     }
-    rounds = lc_projection_active_set_solve(ps, p.rows, p.xy, p.m, p.nb, p.inv_mass, p.inv_inertia, b, 1e-12, 0, lambda,
+    rounds = lc_projection_active_set_solve(ps, p.rows, p.xy, p.m, p.nb, p.inv_mass, p.inv_inertia, b, 1e-12, lambda,
                                             &value);
     CHECK(rounds == 1, "rounds %d", rounds);
     gaps_after(&p, b, lambda, disp, w);
@@ -337,7 +337,7 @@ static void check_start(void)
         double ut;
         lc_contact_row_velocity(&p.rows[i], d0, &b[i], &ut);
     }
-    rounds = lc_projection_active_set_solve(ps, p.rows, p.xy, p.m, p.nb, p.inv_mass, p.inv_inertia, b, 1e-12, 0, lambda,
+    rounds = lc_projection_active_set_solve(ps, p.rows, p.xy, p.m, p.nb, p.inv_mass, p.inv_inertia, b, 1e-12, lambda,
                                             &value);
     CHECK(rounds >= 0, "rounds %d", rounds);
     from_zero = sweeps_from(&p, b, NULL, d0);
