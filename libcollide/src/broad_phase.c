@@ -24,12 +24,31 @@ struct lc_broad_phase_state {
     int tracked;
     lc_buf reach, track_rows, box_stamp;
     unsigned stamp_now;
+    /* The last whole-world search over an interval (s1 != s0): its pairs (kept_count, -1: none) and each
+     * row's state its box came from (s1's row, a static body's s0's), with the world's edits, rows and
+     * margin then. A whole-world search at one state later (the end-of-step projection's) takes from
+     * them the pairs of the rows still at those states (pairs_from_kept). */
+    lc_buf kept_pairs, kept_ref;
+    int kept_count, kept_rows;
+    double kept_margin;
+    unsigned long kept_edits;
+    /* while tracked: 1 for a row whose reach in the grid need not hold its box at kept_ref (a row the
+     * track did not index from the kept search's states, or retracked since); track_kept: the tracked
+     * reach holds every other row's box at kept_ref */
+    lc_buf stale;
+    int track_kept;
+    /* pairs_from_kept's rows at the new state (moved: not at kept_ref, or stale), their boxes (stamped
+     * when computed) and the pairs with a moved row */
+    lc_buf moved, moved_rows, end_boxes, end_stamp, moved_pairs;
+    unsigned end_now;
+    int end_rows;   /* the rows end_stamp was cleared for (-1: none) */
 };
 
 lc_broad_phase_state *lc_broad_phase_state_create(void)
 {
     lc_broad_phase_state *bp = calloc(1, sizeof(lc_broad_phase_state));
     if (bp == NULL) return NULL;
+    bp->kept_count = bp->end_rows = -1;
     bp->grid = lc_reach_grid_create();
     bp->grid_pairs = lc_box_pairs_create();
     if (bp->grid == NULL || bp->grid_pairs == NULL) {
@@ -55,6 +74,14 @@ void lc_broad_phase_state_destroy(lc_broad_phase_state *bp)
     lc_buf_free(&bp->reach);
     lc_buf_free(&bp->track_rows);
     lc_buf_free(&bp->box_stamp);
+    lc_buf_free(&bp->kept_pairs);
+    lc_buf_free(&bp->kept_ref);
+    lc_buf_free(&bp->stale);
+    lc_buf_free(&bp->moved);
+    lc_buf_free(&bp->moved_rows);
+    lc_buf_free(&bp->end_boxes);
+    lc_buf_free(&bp->end_stamp);
+    lc_buf_free(&bp->moved_pairs);
     lc_reach_grid_destroy(bp->grid);
     lc_box_pairs_destroy(bp->grid_pairs);
     free(bp);
@@ -319,11 +346,168 @@ static int pairs_of(lc_world *w, box *boxes, lc_buf *buf)
     return count;
 }
 
+static int cmp_pair(const void *x, const void *y)
+{
+    const int *a = x, *b = y;
+    if (a[0] != b[0]) return (a[0] > b[0]) - (a[0] < b[0]);
+    return (a[1] > b[1]) - (a[1] < b[1]);
+}
+
+/* The search over s0 -> s1 (s1 != s0) that found `count` pairs in buf, kept for pairs_from_kept. */
+static void keep_search(lc_world *w, const double *s0, const double *s1, double margin, const lc_buf *buf, int count)
+{
+    lc_broad_phase_state *bp = w->broad_phase;
+    int n = w->count, i;
+    int *p = lc_buf_get(&bp->kept_pairs, (size_t)(count > 0 ? count : 1) * 2 * sizeof(int));
+    double *ref = lc_buf_get(&bp->kept_ref, (size_t)(n > 0 ? n : 1) * 6 * sizeof(double));
+    bp->kept_count = -1;
+    bp->track_kept = 0;
+    /* nothing kept without memory (the next search looks at every box), nor from a search that left
+     * rows out: a later one may take them */
+    if (p == NULL || ref == NULL || w->excluded != NULL) return;
+    if (count > 0) memcpy(p, buf->p, (size_t)count * 2 * sizeof(int));
+    memcpy(ref, s1, (size_t)n * 6 * sizeof(double));
+    for (i = 0; i < n; ++i)
+        if (w->is_static[i]) memcpy(&ref[i * 6], &s0[i * 6], 6 * sizeof(double));
+    bp->kept_count = count;
+    bp->kept_rows = n;
+    bp->kept_margin = margin;
+    bp->kept_edits = w->edits;
+}
+
+static int same_row(const double *a, const double *b) { return memcmp(a, b, 6 * sizeof(double)) == 0; }
+
+static int pair_after(const int *x, const int *y) { return x[0] > y[0] || (x[0] == y[0] && x[1] > y[1]); }
+
+/* Row r's box at state s (margin grown), computed once per pairs_from_kept. */
+static const box *end_box_of(lc_world *w, const double *s, int r, double margin)
+{
+    lc_broad_phase_state *bp = w->broad_phase;
+    box *b = &((box *)bp->end_boxes.p)[r];
+    unsigned *stamp = (unsigned *)bp->end_stamp.p;
+    if (stamp[r] != bp->end_now) {
+        swept_box(w, s, s, r, margin, b);
+        stamp[r] = bp->end_now;
+    }
+    return b;
+}
+
+/* The whole-world pairs at state s from the kept search over an interval, without a search of every
+ * box: the same pairs in the same order as pairs_of(swept_boxes(s, s)), or -2 when they cannot be had
+ * this way (then the caller searches), -1 without memory.
+ * A row at its kept state has its box inside its box of the kept search (its box over the interval
+ * holds its box at the interval's end, the same bits from the same state), so two such rows whose boxes
+ * meet were a kept pair: those pairs are the kept ones whose boxes at s still meet, in the kept order.
+ * A row not at its kept state (an impact moved it) meets one at it only where that one's reach in the
+ * tracked grid is, which holds its box at the kept state: the moved rows' pairs come from the grid and
+ * from each other, sorted and merged in. Without the grid they need the whole search, as do many of
+ * them (past a quarter of the rows the search costs less). */
+static int pairs_from_kept(lc_world *w, const double *s, double margin, lc_buf *buf)
+{
+    lc_broad_phase_state *bp = w->broad_phase;
+    const double *ref = (const double *)bp->kept_ref.p;
+    const int *kept = (const int *)bp->kept_pairs.p;
+    const uint8_t *stale = (const uint8_t *)bp->stale.p;
+    int n = w->count, i, k, q, m = 0, count = 0, nm = 0, *out, *mp;
+    uint8_t *moved;
+    int *mrows;
+    if (bp->kept_count < 0 || bp->kept_rows != n || bp->kept_margin != margin || bp->kept_edits != w->edits ||
+        w->excluded != NULL)
+        return -2;
+    moved = lc_buf_get(&bp->moved, (size_t)(n > 0 ? n : 1));
+    mrows = lc_buf_get(&bp->moved_rows, (size_t)(n > 0 ? n : 1) * sizeof(int));
+    if (moved == NULL || mrows == NULL || lc_buf_get(&bp->end_boxes, (size_t)(n > 0 ? n : 1) * sizeof(box)) == NULL ||
+        lc_buf_get(&bp->end_stamp, (size_t)(n > 0 ? n : 1) * sizeof(unsigned)) == NULL)
+        return -1;
+    {
+        int use_stale = bp->tracked && bp->track_kept;
+        for (i = 0; i < n; ++i) {
+            moved[i] = !same_row(&s[i * 6], &ref[i * 6]) || (use_stale && stale[i]);
+            if (moved[i]) {
+                if (m >= n / 4 + 1 || !use_stale) return -2;
+                mrows[m++] = i;
+            }
+        }
+    }
+    if (bp->end_rows != n || ++bp->end_now == 0) {   /* another world size, or the stamps wrapped */
+        memset(bp->end_stamp.p, 0, (size_t)(n > 0 ? n : 1) * sizeof(unsigned));
+        bp->end_rows = n;
+        bp->end_now = 1;
+    }
+    /* the kept pairs of two unmoved rows whose boxes still meet, in the kept (brute force's) order */
+    out = lc_buf_get(buf, (size_t)(bp->kept_count + 1) * 2 * sizeof(int));
+    if (out == NULL) return -1;
+    for (k = 0; k < bp->kept_count; ++k) {
+        int a = kept[2 * k], b = kept[2 * k + 1];
+        if (moved[a] || moved[b] || !overlap(end_box_of(w, s, a, margin), end_box_of(w, s, b, margin))) continue;
+        out[2 * count] = a;
+        out[2 * count + 1] = b;
+        count++;
+    }
+    /* the pairs with a moved row (add_if_near's rules: excluded is NULL here) */
+    for (k = 0; k < m; ++k) {
+        int a = mrows[k], nnear;
+        const int *near;
+        const box *ba = end_box_of(w, s, a, margin);
+        double qb[4];
+        qb[0] = ba->x0;
+        qb[1] = ba->y0;
+        qb[2] = ba->x1;
+        qb[3] = ba->y1;
+        nnear = lc_reach_grid_query(bp->grid, qb, &near);
+        if (nnear < 0) return -1;
+        for (q = 0; q < nnear; ++q) {
+            int b = near[q];
+            if (moved[b] || (w->is_static[a] && w->is_static[b])) continue;   /* moved pairs: below */
+            if (!overlap(ba, end_box_of(w, s, b, margin))) continue;
+            if ((nm = add_pair(&bp->moved_pairs, nm, a, b)) < 0) return -1;
+        }
+        for (q = k + 1; q < m; ++q) {
+            int b = mrows[q];
+            if (w->is_static[a] && w->is_static[b]) continue;
+            if (!overlap(end_box_of(w, s, a, margin), end_box_of(w, s, b, margin))) continue;
+            if ((nm = add_pair(&bp->moved_pairs, nm, a, b)) < 0) return -1;
+        }
+    }
+    if (nm > 0) {
+        int j, t;
+        mp = (int *)bp->moved_pairs.p;
+        if (nm > 1) qsort(mp, (size_t)nm, 2 * sizeof(int), cmp_pair);
+        out = lc_buf_get(buf, (size_t)(count + nm) * 2 * sizeof(int));
+        if (out == NULL) return -1;
+        /* merged from the back: the two lists are sorted and share no pair */
+        i = count - 1;
+        j = nm - 1;
+        for (t = count + nm - 1; j >= 0; --t) {
+            if (i >= 0 && pair_after(&out[2 * i], &mp[2 * j])) {
+                out[2 * t] = out[2 * i];
+                out[2 * t + 1] = out[2 * i + 1];
+                --i;
+            } else {
+                out[2 * t] = mp[2 * j];
+                out[2 * t + 1] = mp[2 * j + 1];
+                --j;
+            }
+        }
+        count += nm;
+    }
+    w->last.broadphase_pairs += (uint64_t)count;
+    return count;
+}
+
 int lc_broad_phase(lc_world *w, const double *s0, const double *s1, double margin, lc_buf *buf)
 {
-    box *boxes = swept_boxes(w, s0, s1, margin);
+    box *boxes;
+    int count;
+    if (s1 == s0) {
+        count = pairs_from_kept(w, s0, margin, buf);
+        if (count != -2) return count;
+    }
+    boxes = swept_boxes(w, s0, s1, margin);
     if (boxes == NULL) return -1;
-    return pairs_of(w, boxes, buf);
+    count = pairs_of(w, boxes, buf);
+    if (count >= 0 && s1 != s0) keep_search(w, s0, s1, margin, buf, count);
+    return count;
 }
 
 static void box_out(const box *b, double out[4])
@@ -403,6 +587,18 @@ int lc_broad_phase_track(lc_world *w, const double *s0, const double *s1, double
     for (i = 0; i < n; ++i) reach_box(w, s0, s1, h, all[i], margin, &reach[4 * all[i]]);
     if (lc_reach_grid_build(bp->grid, reach, all, n, w->count) != 0) return -1;
     bp->tracked = 1;
+    /* a row's reach holds its box at s1 (a static body's at s0): where that is its kept state, the
+     * grid finds it for pairs_from_kept */
+    bp->track_kept = 0;
+    if (bp->kept_count >= 0 && bp->kept_rows == w->count && bp->kept_margin == margin && bp->kept_edits == w->edits &&
+        n == w->count) {
+        uint8_t *stale = lc_buf_get(&bp->stale, (size_t)(w->count > 0 ? w->count : 1));
+        const double *ref = (const double *)bp->kept_ref.p;
+        if (stale != NULL) {
+            for (i = 0; i < w->count; ++i) stale[i] = !same_row(w->is_static[i] ? &s0[i * 6] : &s1[i * 6], &ref[i * 6]);
+            bp->track_kept = 1;
+        }
+    }
     return 0;
 }
 
@@ -414,6 +610,7 @@ int lc_broad_phase_retrack(lc_world *w, const double *s0, const double *s1, doub
     if (!bp->tracked) return 0;
     for (k = 0; k < nrows; ++k) {
         double r[4];
+        if (bp->track_kept) ((uint8_t *)bp->stale.p)[rows[k]] = 1;   /* its reach is its new path's */
         reach_box(w, s0, s1, h, rows[k], margin, r);
         if (lc_reach_grid_move(bp->grid, rows[k], r) != 0) {
             bp->tracked = 0;
@@ -429,13 +626,6 @@ int lc_broad_phase_near(lc_world *w, const double box4[4], const int **out)
 {
     if (!w->broad_phase->tracked) return -2;
     return lc_reach_grid_query(w->broad_phase->grid, box4, out);
-}
-
-static int cmp_pair(const void *x, const void *y)
-{
-    const int *a = x, *b = y;
-    if (a[0] != b[0]) return (a[0] > b[0]) - (a[0] < b[0]);
-    return (a[1] > b[1]) - (a[1] < b[1]);
 }
 
 /* lc_broad_phase_of from the tracked reach: each listed row's partners are the bodies whose reach its

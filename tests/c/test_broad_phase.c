@@ -15,7 +15,13 @@
  * pairs that have a listed body, also while the broad phase tracks an interval in its grid
  * (lc_broad_phase_track): at a state inside the interval, and after a hundred bodies changed paths
  * (lc_broad_phase_retrack: their new boxes in the cells' lists beside the table), and after every path
- * changed three times more (past the entries at which the grid is built anew). The reach grid alone, with
+ * changed three times more (past the entries at which the grid is built anew). A search at one state
+ * after a search over an interval takes the interval's pairs where it can (pairs_from_kept): at the
+ * interval's end state, with a few bodies moved elsewhere while the interval is tracked, and with a
+ * tracked body given a new path (retracked) but back at its end state, its pairs must be exactly brute
+ * force's over the boxes at that state, in the same order, and no search of the world must have run;
+ * with a third of the bodies moved, or a body moved and nothing tracked, the world is searched, with
+ * the same pairs. The reach grid alone, with
  * two finite boxes near -1e308 and 1e308 beside two at the origin (bounds wider than a double spans, where
  * doubling the cell would never end): it is built, and each query finds exactly the boxes it overlaps. */
 #include <math.h>
@@ -123,6 +129,46 @@ static void compare_of(lc_world *w, const double *s0, const double *s1, const ch
     free(marked);
 }
 
+/* Every pair a < b, not both static, whose boxes at state s (grown by contact_distance) overlap, in
+ * (a, b) order: brute force written out, into out (count returned). */
+static int pairs_at(lc_world *w, const double *s, int *out)
+{
+    int a, b, n = 0;
+    double ba[4], bb[4];
+    for (a = 0; a < w->count; ++a) {
+        lc_swept_box(w, s, s, a, w->def.contact_distance, ba);
+        for (b = a + 1; b < w->count; ++b) {
+            if (w->is_static[a] && w->is_static[b]) continue;
+            lc_swept_box(w, s, s, b, w->def.contact_distance, bb);
+            if (ba[0] <= bb[2] && bb[0] <= ba[2] && ba[1] <= bb[3] && bb[1] <= ba[3]) {
+                out[2 * n] = a;
+                out[2 * n + 1] = b;
+                n++;
+            }
+        }
+    }
+    return n;
+}
+
+/* lc_broad_phase at the one state s after a search over an interval: brute force's pairs at s, in
+ * order, and a search of the world (a broadphase counted) only when `searched`. */
+static void compare_kept(lc_world *w, const double *s, const char *what, int searched, int *brute, int *got)
+{
+    lc_buf buf = {0};
+    uint64_t before = w->last.brute_force_steps + w->last.sort_and_sweep_steps + w->last.grid_steps, after;
+    int nb = pairs_at(w, s, brute), n;
+    w->def.broadphase = LC_BROADPHASE_GRID;
+    n = lc_broad_phase(w, s, s, w->def.contact_distance, &buf);
+    after = w->last.brute_force_steps + w->last.sort_and_sweep_steps + w->last.grid_steps;
+    if (n > 0) memcpy(got, buf.p, (size_t)n * 2 * sizeof(int));
+    printf("%-34s %6d pairs (brute force) %6d (%s)\n", what, nb, n, after > before ? "searched" : "kept pairs");
+    CHECK(nb > 0, "%s: the scene has candidate pairs", what);
+    CHECK(n == nb, "%s: %d pairs by brute force, %d found", what, nb, n);
+    if (n == nb) CHECK(memcmp(brute, got, (size_t)nb * 2 * sizeof(int)) == 0, "%s: the same pairs in the same order", what);
+    CHECK((after > before) == searched, "%s: the world %s searched", what, searched ? "must be" : "must not be");
+    lc_buf_free(&buf);
+}
+
 static void check_reach_grid_far_apart(void)
 {
     double boxes[16] = {-1.0, -1.0, 0.5, 0.5, 0.0, 0.0, 1.0, 1.0, -1.5e308, 0.0, -1.4e308, 1.0, 1.4e308, 0.0, 1.5e308, 1.0};
@@ -184,6 +230,43 @@ int main(void)
     for (i = 1; i < rows; i++) s1[i * 6 + SX] += sc_uniform(&rng, -2.0, 2.0);
     compare(w, s0, s1, "swept over an interval", brute, sweep);
     compare_of(w, s0, s1, "swept over an interval", brute, sweep, &rng);
+    {
+        /* the interval's pairs taken at its end, then with bodies moved (the interval searched last) */
+        int *dyn = malloc((size_t)rows * sizeof(int)), nd = 0, k;
+        double *e = malloc((size_t)rows * 6 * sizeof(double));
+        CHECK(dyn && e, "%s", "allocation");
+        if (dyn && e) {
+            for (k = 1; k < rows; k++) dyn[nd++] = k;
+            memcpy(e, s1, (size_t)rows * 6 * sizeof(double));
+            pairs_of(w, LC_BROADPHASE_GRID, s0, s1, sweep);
+            compare_kept(w, e, "interval's end", 0, brute, sweep);
+            CHECK(lc_broad_phase_track(w, s0, s1, 0.0, dyn, nd, w->def.contact_distance) == 0, "%s", "track");
+            for (k = 1; k <= 20; k++) {
+                e[k * 6 + SX] += sc_uniform(&rng, -3.0, 3.0);
+                e[k * 6 + SA] += sc_uniform(&rng, -1.0, 1.0);
+            }
+            compare_kept(w, e, "tracked, 20 bodies moved", 0, brute, sweep);
+            /* body 30 on a new path far off in the grid, yet at its end state, where moved body 5 now is:
+             * their pair is not where the grid has body 30 */
+            {
+                double s2[6 * 31];
+                memcpy(s2, s1, sizeof s2);
+                s2[30 * 6 + SY] += 50.0;
+                CHECK(lc_broad_phase_retrack(w, s2, s2, 0.0, &dyn[29], 1, w->def.contact_distance) == 0, "%s", "retrack");
+                e[5 * 6 + SX] = e[30 * 6 + SX];
+                e[5 * 6 + SY] = e[30 * 6 + SY];
+            }
+            compare_kept(w, e, "tracked, one path changed", 0, brute, sweep);
+            for (k = 21; k <= rows / 3; k++) e[k * 6 + SY] += sc_uniform(&rng, -1.0, 1.0);
+            compare_kept(w, e, "tracked, a third of bodies moved", 1, brute, sweep);
+            lc_broad_phase_untrack(w);
+            memcpy(e, s1, (size_t)rows * 6 * sizeof(double));
+            e[7 * 6 + SX] += 1.0;
+            compare_kept(w, e, "untracked, one body moved", 1, brute, sweep);
+        }
+        free(dyn);
+        free(e);
+    }
     {
         /* tracked: every dynamic body's reach from s0 to s1 (straight paths: h = 0, no parabola) */
         int *dyn = malloc((size_t)rows * sizeof(int)), nd = 0, k;
