@@ -12,11 +12,17 @@
 #include "reach_grid.h"
 #include "grid_shape.h"
 
+#ifndef LC_REACH_GRID_CELL
+#define LC_REACH_GRID_CELL 2.0   /* the cell over the boxes' mean extent: a typical box covers one to four
+                                    cells, and a build (every body, once per tracked interval) writes
+                                    fewer entries than with cells of the mean extent, at little cost to
+                                    the queries (a few per impact) */
+#endif
 #define LC_GRID_MAX_SPAN 4   /* a box over more cells than this along an axis goes to the wide list */
 
 struct lc_reach_grid {
     int count;                       /* rows of the world */
-    double x0, y0, cell;             /* the grid's origin and cell size */
+    double x0, y0, cell, inv;        /* the grid's origin, cell size and 1 / cell */
     int nx, ny;
     lc_buf box;                      /* count x 4: each indexed row's box */
     lc_buf state;                    /* count: 0 not indexed, 1 in the table, 2 wide, 3 moved */
@@ -29,6 +35,7 @@ struct lc_reach_grid {
     lc_buf stamp, found;             /* a query's dedup stamps (count) and its result */
     unsigned stamp_now;
     lc_buf rows_tmp;                 /* the rebuild's row list */
+    lc_buf range;                    /* the build's cell range of each row it indexes (4 ints by row) */
 };
 
 lc_reach_grid *lc_reach_grid_create(void) { return calloc(1, sizeof(lc_reach_grid)); }
@@ -45,21 +52,30 @@ void lc_reach_grid_destroy(lc_reach_grid *g)
     lc_buf_free(&g->stamp);
     lc_buf_free(&g->found);
     lc_buf_free(&g->rows_tmp);
+    lc_buf_free(&g->range);
     lc_buf_free(&g->over_head);
     lc_buf_free(&g->over_next);
     lc_buf_free(&g->over_row);
     free(g);
 }
 
+/* The cell of coordinate v along an axis of `cells` cells from origin o, clamped to the grid. Any
+ * mapping monotone in v serves, as long as the build, the moves and the queries share it (two
+ * overlapping intervals then share a cell): the product by 1 / cell is, and the cast truncates, which
+ * is the floor from 1 up. No call to floor and no division: a build maps every row's box. */
+static int cell_of(double v, double o, double inv, int cells)
+{
+    double f = (v - o) * inv;
+    return f < 1.0 ? 0 : (f >= cells ? cells - 1 : (int)f);
+}
+
 /* The cell range [i0, i1] x [j0, j1] a box covers, clamped to the grid. */
 static void cell_range(const lc_reach_grid *g, const double *b, int *i0, int *j0, int *i1, int *j1)
 {
-    double fx0 = floor((b[0] - g->x0) / g->cell), fy0 = floor((b[1] - g->y0) / g->cell);
-    double fx1 = floor((b[2] - g->x0) / g->cell), fy1 = floor((b[3] - g->y0) / g->cell);
-    *i0 = fx0 < 0.0 ? 0 : (fx0 > g->nx - 1 ? g->nx - 1 : (int)fx0);
-    *j0 = fy0 < 0.0 ? 0 : (fy0 > g->ny - 1 ? g->ny - 1 : (int)fy0);
-    *i1 = fx1 < 0.0 ? 0 : (fx1 > g->nx - 1 ? g->nx - 1 : (int)fx1);
-    *j1 = fy1 < 0.0 ? 0 : (fy1 > g->ny - 1 ? g->ny - 1 : (int)fy1);
+    *i0 = cell_of(b[0], g->x0, g->inv, g->nx);
+    *j0 = cell_of(b[1], g->y0, g->inv, g->ny);
+    *i1 = cell_of(b[2], g->x0, g->inv, g->nx);
+    *j1 = cell_of(b[3], g->y0, g->inv, g->ny);
 }
 
 static int is_wide(const lc_reach_grid *g, const double *b)
@@ -74,29 +90,31 @@ int lc_reach_grid_build(lc_reach_grid *g, const double *boxes4, const int *rows,
     int *wide = lc_buf_get(&g->wide, (size_t)(n > 0 ? n : 1) * sizeof(int));
     int *moved = lc_buf_get(&g->moved, (size_t)(n > 0 ? n : 1) * sizeof(int));
     unsigned *stamp = lc_buf_get(&g->stamp, (size_t)(count > 0 ? count : 1) * sizeof(unsigned));
+    int *range = lc_buf_get(&g->range, (size_t)(count > 0 ? count : 1) * 4 * sizeof(int));
     double ext = 0.0, xmin = INFINITY, ymin = INFINITY, xmax = -INFINITY, ymax = -INFINITY;
     int *start, *cells, i, k, ncell, small = 0;
-    if (!box || !state || !wide || !moved || !stamp) return -1;
+    if (!box || !state || !wide || !moved || !stamp || !range) return -1;
     if (g->count != count) {
         memset(stamp, 0, (size_t)(count > 0 ? count : 1) * sizeof(unsigned));
         g->stamp_now = 0;
     }
     g->count = count;
     memset(state, 0, (size_t)(count > 0 ? count : 1));
-    /* the cell: the mean extent of the boxes, so a typical box covers one to four cells */
+    /* the cell: LC_REACH_GRID_CELL times the mean extent of the boxes */
     for (k = 0; k < n; ++k) {
         const double *b = &boxes4[4 * rows[k]];
+        double wx = b[2] - b[0], wy = b[3] - b[1];
         if (b != &box[4 * rows[k]]) memcpy(&box[4 * rows[k]], b, 4 * sizeof(double));
-        ext += fmax(b[2] - b[0], b[3] - b[1]);
+        ext += wx > wy ? wx : wy;   /* finite boxes: comparisons, not calls to fmax and fmin */
     }
-    g->cell = n > 0 && ext > 0.0 ? ext / n : 1.0;
+    g->cell = n > 0 && ext > 0.0 ? LC_REACH_GRID_CELL * ext / n : 1.0;
     for (k = 0; k < n; ++k) {
         const double *b = &box[4 * rows[k]];
         if (is_wide(g, b)) continue;
-        xmin = fmin(xmin, b[0]);
-        ymin = fmin(ymin, b[1]);
-        xmax = fmax(xmax, b[2]);
-        ymax = fmax(ymax, b[3]);
+        if (b[0] < xmin) xmin = b[0];
+        if (b[1] < ymin) ymin = b[1];
+        if (b[2] > xmax) xmax = b[2];
+        if (b[3] > ymax) ymax = b[3];
         small++;
     }
     if (small == 0) xmin = ymin = xmax = ymax = 0.0;
@@ -108,6 +126,7 @@ int lc_reach_grid_build(lc_reach_grid *g, const double *boxes4, const int *rows,
     }
     g->x0 = xmin;
     g->y0 = ymin;
+    g->inv = 1.0 / g->cell;
     ncell = g->nx * g->ny;
     start = lc_buf_get(&g->cell_start, (size_t)(ncell + 1) * sizeof(int));
     {
@@ -118,16 +137,16 @@ int lc_reach_grid_build(lc_reach_grid *g, const double *boxes4, const int *rows,
     memset(start, 0, (size_t)(ncell + 1) * sizeof(int));
     g->nwide = g->nmoved = g->nover = 0;
     for (k = 0; k < n; ++k) {
-        int r = rows[k], i0, j0, i1, j1, ii, jj;
+        int r = rows[k], *c = &range[4 * r], ii, jj;
         if (is_wide(g, &box[4 * r])) {
             state[r] = 2;
             wide[g->nwide++] = r;
             continue;
         }
         state[r] = 1;
-        cell_range(g, &box[4 * r], &i0, &j0, &i1, &j1);
-        for (jj = j0; jj <= j1; ++jj)
-            for (ii = i0; ii <= i1; ++ii) start[jj * g->nx + ii + 1]++;
+        cell_range(g, &box[4 * r], &c[0], &c[1], &c[2], &c[3]);
+        for (jj = c[1]; jj <= c[3]; ++jj)
+            for (ii = c[0]; ii <= c[2]; ++ii) start[jj * g->nx + ii + 1]++;
     }
     for (i = 0; i < ncell; ++i) start[i + 1] += start[i];
     cells = lc_buf_get(&g->cell_rows, (size_t)(start[ncell] > 0 ? start[ncell] : 1) * sizeof(int));
@@ -135,11 +154,11 @@ int lc_reach_grid_build(lc_reach_grid *g, const double *boxes4, const int *rows,
     /* rows in ascending order within each cell (the pass goes through rows in their given order, and
      * start[] counts forward: start[c] becomes the cell's end) */
     for (k = 0; k < n; ++k) {
-        int r = rows[k], i0, j0, i1, j1, ii, jj;
+        int r = rows[k], ii, jj;
+        const int *c = &range[4 * r];
         if (state[r] != 1) continue;
-        cell_range(g, &box[4 * r], &i0, &j0, &i1, &j1);
-        for (jj = j0; jj <= j1; ++jj)
-            for (ii = i0; ii <= i1; ++ii) cells[start[jj * g->nx + ii]++] = r;
+        for (jj = c[1]; jj <= c[3]; ++jj)
+            for (ii = c[0]; ii <= c[2]; ++ii) cells[start[jj * g->nx + ii]++] = r;
     }
     for (i = ncell; i > 0; --i) start[i] = start[i - 1];
     start[0] = 0;
@@ -248,7 +267,19 @@ int lc_reach_grid_query(lc_reach_grid *g, const double q[4], const int **out)
     for (k = 0; k < g->nwide; ++k) LC_GRID_TAKE(((const int *)g->wide.p)[k]);
     for (k = 0; k < g->nmoved; ++k) LC_GRID_TAKE(((const int *)g->moved.p)[k]);
 #undef LC_GRID_TAKE
-    if (n > 1) qsort(found, (size_t)n, sizeof(int), cmp_int);
+    /* a query finds a few rows: an insertion sort, without qsort's calls per comparison */
+    if (n > 32) {
+        qsort(found, (size_t)n, sizeof(int), cmp_int);
+    } else {
+        for (k = 1; k < n; ++k) {
+            int r = found[k], q = k;
+            while (q > 0 && found[q - 1] > r) {
+                found[q] = found[q - 1];
+                --q;
+            }
+            found[q] = r;
+        }
+    }
     *out = found;
     return n;
 }
