@@ -39,7 +39,7 @@ struct lc_broad_phase_state {
     int track_kept;
     /* pairs_from_kept's rows at the new state (moved: not at kept_ref, or stale), their boxes (stamped
      * when computed) and the pairs with a moved row */
-    lc_buf moved, moved_rows, end_boxes, end_stamp, moved_pairs;
+    lc_buf moved, moved_rows, end_boxes, end_stamp, moved_pairs, moved_boxes;
     unsigned end_now;
     int end_rows;   /* the rows end_stamp was cleared for (-1: none) */
 };
@@ -82,6 +82,7 @@ void lc_broad_phase_state_destroy(lc_broad_phase_state *bp)
     lc_buf_free(&bp->end_boxes);
     lc_buf_free(&bp->end_stamp);
     lc_buf_free(&bp->moved_pairs);
+    lc_buf_free(&bp->moved_boxes);
     lc_reach_grid_destroy(bp->grid);
     lc_box_pairs_destroy(bp->grid_pairs);
     free(bp);
@@ -462,12 +463,24 @@ static int pairs_from_kept(lc_world *w, const double *s, double margin, lc_buf *
             if (!overlap(ba, end_box_of(w, s, b, margin))) continue;
             if ((nm = add_pair(&bp->moved_pairs, nm, a, b)) < 0) return -1;
         }
-        for (q = k + 1; q < m; ++q) {
-            int b = mrows[q];
-            if (w->is_static[a] && w->is_static[b]) continue;
-            if (!overlap(end_box_of(w, s, a, margin), end_box_of(w, s, b, margin))) continue;
-            if ((nm = add_pair(&bp->moved_pairs, nm, a, b)) < 0) return -1;
+    }
+    /* the moved rows among themselves: a sweep along x over their boxes (every impact of a step adds
+     * moved rows, and testing each against each grew as the square of the world's size) */
+    if (m > 1) {
+        box *mb = lc_buf_get(&bp->moved_boxes, (size_t)m * sizeof(box));
+        if (mb == NULL) return -1;
+        for (k = 0; k < m; ++k) {
+            mb[k] = *end_box_of(w, s, mrows[k], margin);
+            /* a non-finite box leaves cmp_box no total order: the whole search instead */
+            if (!(mb[k].x0 > -INFINITY && mb[k].x1 < INFINITY)) return -2;
         }
+        qsort(mb, (size_t)m, sizeof(box), cmp_box);
+        for (k = 0; k < m; ++k)
+            for (q = k + 1; q < m && mb[q].x0 <= mb[k].x1; ++q) {
+                if (w->is_static[mb[k].row] && w->is_static[mb[q].row]) continue;
+                if (!overlap(&mb[k], &mb[q])) continue;
+                if ((nm = add_pair(&bp->moved_pairs, nm, mb[k].row, mb[q].row)) < 0) return -1;
+            }
     }
     if (nm > 0) {
         int j, t;
