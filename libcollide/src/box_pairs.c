@@ -81,7 +81,8 @@ int lc_box_pairs_find(lc_box_pairs *g, const void *boxes, size_t stride, int n,
         const double *b = box_at(boxes, stride, k);
         kind[k] = gridable(b) ? SMALL : ODD;
         if (kind[k] == SMALL) {
-            ext += fmax(b[2] - b[0], b[3] - b[1]);
+            double wx = b[2] - b[0], wy = b[3] - b[1];
+            ext += wx > wy ? wx : wy;   /* finite: comparisons, not calls to fmax and fmin, here and below */
             small++;
         }
     }
@@ -91,10 +92,10 @@ int lc_box_pairs_find(lc_box_pairs *g, const void *boxes, size_t stride, int n,
     for (k = 0; k < n; ++k) {
         const double *b = box_at(boxes, stride, k);
         if (kind[k] != SMALL || b[2] - b[0] > span || b[3] - b[1] > span) continue;
-        xmin = fmin(xmin, b[0]);
-        ymin = fmin(ymin, b[1]);
-        xmax = fmax(xmax, b[2]);
-        ymax = fmax(ymax, b[3]);
+        if (b[0] < xmin) xmin = b[0];
+        if (b[1] < ymin) ymin = b[1];
+        if (b[2] > xmax) xmax = b[2];
+        if (b[3] > ymax) ymax = b[3];
         small++;
     }
     if (small == 0) xmin = ymin = xmax = ymax = 0.0;
