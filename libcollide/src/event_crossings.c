@@ -96,6 +96,7 @@ static int drop_stalled_from(lc_event_crossings *ec, const lc_crossing *stalled,
 {
     lc_crossing *c = (lc_crossing *)ec->cross.p;
     int i, k, kept = from;
+    if (nstalled == 0) return nc;   /* nothing to drop: no pass over every pending crossing */
     for (i = from; i < nc; ++i) {
         int skip = 0;
         for (k = 0; k < nstalled && !skip; ++k)
@@ -155,12 +156,16 @@ static int keep_clean_crossings(lc_event_crossings *ec, const uint8_t *dirty, do
     lc_crossing *c = (lc_crossing *)ec->cross.p;
     int i, kept = 0, nc = ec->count;
     for (i = 0; i < nc; ++i) {
+        double lo = c[i].t_lo - tmin, clear = c[i].clear_to - tmin;
         if (dirty[c[i].a] || dirty[c[i].b]) continue;
         c[i].t_hi -= tmin;
-        c[i].t_lo = fmax(c[i].t_lo - tmin, 0.0);
-        c[i].clear_to = fmax(c[i].clear_to - tmin, 0.0);
+        /* fmax(x, 0.0) by comparison, the same bits (a NaN or either zero gives +0.0), without a call per
+         * pending crossing at every impact */
+        c[i].t_lo = lo > 0.0 ? lo : 0.0;
+        c[i].clear_to = clear > 0.0 ? clear : 0.0;
         if (!(c[i].t_hi > 0.0)) continue;
-        c[kept++] = c[i];
+        if (kept != i) c[kept] = c[i];   /* most stay where they are */
+        kept++;
     }
     return kept;
 }
@@ -224,9 +229,12 @@ static int pair_at(lc_world *w, const double *s0, double t, int a, int b, const 
  * A coupled pair (touching others, or tied by a spring) moves with the whole world, whose sub-time
  * states are computed once per interval and shared by every such pair: in a pile each of them costs
  * a contact-force solve of the whole pile per integrator stage, and a settling 1275-box pyramid has
- * hundreds of near pairs in one interval. */
+ * hundreds of near pairs in one interval.
+ * No crossing before index `from` has a body of any of the pairs (a local pass: those are the kept
+ * crossings of bodies the impact did not move, and every pair has a moved body), so the crossings are
+ * looked through from there: after each impact, not every crossing pending in the world. */
 static int swept_check(lc_world *w, lc_event_crossings *ec, const double *s0, const double *s1, double h,
-                       const int *pairs, int np, int nc, const unsigned *coupled, unsigned coupled_now,
+                       const int *pairs, int np, int from, int nc, const unsigned *coupled, unsigned coupled_now,
                        const int *all_rows, int n_all,
                        lc_touch *rest, int nrest, const uint8_t *in_parts)
 {
@@ -240,7 +248,7 @@ static int swept_check(lc_world *w, lc_event_crossings *ec, const double *s0, co
     in_cross = (unsigned *)ec->in_cross.p;
     /* the bodies of the crossings so far: a pair with a body in none has no crossing (the list of
      * crossings need not be searched for each of the interval's pairs) */
-    for (i = 0; i < nc; ++i)
+    for (i = from; i < nc; ++i)
         in_cross[((const lc_crossing *)ec->cross.p)[i].a] = in_cross[((const lc_crossing *)ec->cross.p)[i].b] = now;
     own[0] = own[1] = NULL;
     for (p = 0; p < np; ++p) {
@@ -248,7 +256,7 @@ static int swept_check(lc_world *w, lc_event_crossings *ec, const double *s0, co
         const double *prev, *cur;
         if (in_parts != NULL && in_parts[p]) continue;   /* swept part by part */
         if (in_cross[a] == now && in_cross[b] == now)
-            for (i = 0; i < nc; ++i) {
+            for (i = from; i < nc; ++i) {
                 const lc_crossing *c = &((const lc_crossing *)ec->cross.p)[i];
                 if ((c->a == a && c->b == b) || (c->a == b && c->b == a)) have = 1;
             }
@@ -420,8 +428,9 @@ int lc_event_crossings_find(lc_world *w, lc_event_crossings *ec, const lc_trial 
     if (new_stamp(&ec->coupled, &ec->coupled_now, &ec->coupled_rows, w->count) == 0) return -1;
     coupled = (unsigned *)ec->coupled.p;
     mark_coupled(w, coupled, tr, ec->coupled_now);
-    nc = swept_check(w, ec, tr->s0, tr->s1, tr->h, pairs, np, nc, coupled, ec->coupled_now, tr->rows, tr->nrows,
-                     tr->rest, tr->nrest, in_parts);
+    /* the kept crossings stay at the front unless a drop above went through them */
+    nc = swept_check(w, ec, tr->s0, tr->s1, tr->h, pairs, np, nstalled_kept == 0 && tr->nrest == 0 ? nkept : 0, nc,
+                     coupled, ec->coupled_now, tr->rows, tr->nrows, tr->rest, tr->nrest, in_parts);
     if (nc < 0) return -1;
     *out = (lc_crossing *)ec->cross.p;
     ec->count = nc;
