@@ -1,6 +1,8 @@
 /* Broad phase: candidate body pairs from swept bounding boxes. Brute force for a few bodies,
  * sort-and-sweep along x from broadphase_threshold, pairs from a uniform grid (box_pairs.c) from
- * LC_GRID_MIN_ROWS (AUTO); all three find the same pairs in the same order. */
+ * LC_GRID_MIN_ROWS (AUTO), over an interval from fat boxes the grid keeps between searches
+ * (pairs_of_fat); all find the same pairs in the same order. A search at one state takes the last
+ * interval search's pairs where it can (pairs_from_kept). */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -8,6 +10,12 @@
 #include "reach_grid.h"
 #include "box_pairs.h"
 #include "tunables.h"
+
+#ifndef LC_FAT_GROW
+#define LC_FAT_GROW 0.25   /* a fat box over its box, on each side, in the boxes' mean extent: a spinning
+                              free-flight block leaves one after a few steps; twice that made more fat
+                              pairs to test than it saved in new fat boxes (callgrind, 5000 blocks) */
+#endif
 
 typedef struct box { double x0, y0, x1, y1; int row; } box;
 
@@ -42,17 +50,27 @@ struct lc_broad_phase_state {
     lc_buf moved, moved_rows, end_boxes, end_stamp, moved_pairs, moved_boxes;
     unsigned end_now;
     int end_rows;   /* the rows end_stamp was cleared for (-1: none) */
+    /* The grid's searches over an interval (pairs_of_fat): each row's fat box (its box grown by
+     * fat_grow, 4 doubles by row) in fat_grid, and the pairs whose fat boxes overlap (fat_count of them,
+     * in brute force's order; -1: none), with the world's rows, edits and margin they were made for */
+    lc_reach_grid *fat_grid;
+    lc_buf fat_boxes, fat_pairs, fat_new, fat_out, fat_rows;
+    int fat_count, fat_n;
+    double fat_margin, fat_grow;
+    unsigned long fat_edits;
 };
 
 lc_broad_phase_state *lc_broad_phase_state_create(void)
 {
     lc_broad_phase_state *bp = calloc(1, sizeof(lc_broad_phase_state));
     if (bp == NULL) return NULL;
-    bp->kept_count = bp->end_rows = -1;
+    bp->kept_count = bp->end_rows = bp->fat_count = -1;
     bp->grid = lc_reach_grid_create();
+    bp->fat_grid = lc_reach_grid_create();
     bp->grid_pairs = lc_box_pairs_create();
-    if (bp->grid == NULL || bp->grid_pairs == NULL) {
+    if (bp->grid == NULL || bp->fat_grid == NULL || bp->grid_pairs == NULL) {
         lc_reach_grid_destroy(bp->grid);
+        lc_reach_grid_destroy(bp->fat_grid);
         lc_box_pairs_destroy(bp->grid_pairs);
         free(bp);
         return NULL;
@@ -83,7 +101,13 @@ void lc_broad_phase_state_destroy(lc_broad_phase_state *bp)
     lc_buf_free(&bp->end_stamp);
     lc_buf_free(&bp->moved_pairs);
     lc_buf_free(&bp->moved_boxes);
+    lc_buf_free(&bp->fat_boxes);
+    lc_buf_free(&bp->fat_pairs);
+    lc_buf_free(&bp->fat_new);
+    lc_buf_free(&bp->fat_out);
+    lc_buf_free(&bp->fat_rows);
     lc_reach_grid_destroy(bp->grid);
+    lc_reach_grid_destroy(bp->fat_grid);
     lc_box_pairs_destroy(bp->grid_pairs);
     free(bp);
 }
@@ -508,6 +532,176 @@ static int pairs_from_kept(lc_world *w, const double *s, double margin, lc_buf *
     return count;
 }
 
+static int finite_box(const box *b)
+{
+    return b->x0 > -INFINITY && b->x1 < INFINITY && b->y0 > -INFINITY && b->y1 < INFINITY && b->x0 <= b->x1 &&
+           b->y0 <= b->y1;
+}
+
+/* A box's fat box: grown by grow. */
+static void fat_of(const box *b, double grow, double f[4])
+{
+    f[0] = b->x0 - grow;
+    f[1] = b->y0 - grow;
+    f[2] = b->x1 + grow;
+    f[3] = b->y1 + grow;
+}
+
+/* The fat pairs made anew: every row's fat box from its box, in the fat grid, and the pairs whose fat
+ * boxes overlap from the grid search (box_pairs.c), in brute force's order. 0, -1 without memory, -2
+ * for a box the grid cannot hold (then the caller searches the boxes themselves). */
+static int fat_build(lc_world *w, const box *boxes, double margin)
+{
+    lc_broad_phase_state *bp = w->broad_phase;
+    int n = w->count, i;
+    double *fat = lc_buf_get(&bp->fat_boxes, (size_t)(n > 0 ? n : 1) * 4 * sizeof(double));
+    int *rows = lc_buf_get(&bp->fat_rows, (size_t)(n > 0 ? n : 1) * sizeof(int));
+    double ext = 0.0;
+    grid_keep k;
+    bp->fat_count = -1;
+    if (fat == NULL || rows == NULL) return -1;
+    for (i = 0; i < n; ++i) {
+        if (!finite_box(&boxes[i])) return -2;
+        ext += fmax(boxes[i].x1 - boxes[i].x0, boxes[i].y1 - boxes[i].y0);
+    }
+    bp->fat_grow = n > 0 ? LC_FAT_GROW * ext / n : 0.0;
+    for (i = 0; i < n; ++i) {
+        fat_of(&boxes[i], bp->fat_grow, &fat[4 * i]);
+        rows[i] = i;
+        /* a box far out (beyond what a double's sum keeps finite) is searched as it is */
+        if (!(fat[4 * i] > -INFINITY && fat[4 * i + 2] < INFINITY && fat[4 * i + 1] > -INFINITY && fat[4 * i + 3] < INFINITY))
+            return -2;
+    }
+    if (lc_reach_grid_build(bp->fat_grid, fat, rows, n, n) != 0) return -1;
+    k.w = w;
+    k.buf = &bp->fat_pairs;
+    k.count = 0;
+    if (lc_box_pairs_find(bp->grid_pairs, fat, 4 * sizeof(double), n, keep_grid_pair, &k) != 0) return -1;
+    if (k.count > 1 && order_pairs(w, (int *)bp->fat_pairs.p, k.count) != 0) return -1;
+    bp->fat_count = k.count;
+    bp->fat_n = n;
+    bp->fat_margin = margin;
+    bp->fat_edits = w->edits;
+    return 0;
+}
+
+/* The grid's search of boxes[0..n) over an interval (pairs_of's, the same pairs in the same order),
+ * from fat boxes kept between searches: a row's box that left its fat box gets a new one (its box grown
+ * by a share of the mean extent), moved in the fat grid, and the fat pairs of those rows are found
+ * anew there; the pairs are then the fat pairs whose boxes overlap (every box lies in its fat box, so
+ * two boxes that meet have fat boxes that meet). Bodies move a little per step and most keep their fat
+ * boxes for several steps: the search costs a test per row and per fat pair, not a build of the grid.
+ * -1 without memory; -2 where it does not apply (then the caller searches). */
+static int pairs_of_fat(lc_world *w, const box *boxes, double margin, lc_buf *buf)
+{
+    lc_broad_phase_state *bp = w->broad_phase;
+    int n = w->count, i, k, m = 0, nn = 0, count = 0, r;
+    double *fat;
+    int *moved_rows, *fp, *out;
+    uint8_t *moved;
+    if (w->excluded != NULL) return -2;
+    moved = lc_buf_get(&bp->moved, (size_t)(n > 0 ? n : 1));
+    moved_rows = lc_buf_get(&bp->moved_rows, (size_t)(n > 0 ? n : 1) * sizeof(int));
+    if (moved == NULL || moved_rows == NULL) return -1;
+    if (bp->fat_count >= 0 && bp->fat_n == n && bp->fat_margin == margin && bp->fat_edits == w->edits) {
+        fat = (double *)bp->fat_boxes.p;
+        for (i = 0; i < n; ++i) {
+            const box *b = &boxes[i];
+            const double *f = &fat[4 * i];
+            moved[i] = !(b->x0 >= f[0] && b->y0 >= f[1] && b->x1 <= f[2] && b->y1 <= f[3]);
+            if (moved[i]) {
+                if (!finite_box(b)) {
+                    bp->fat_count = -1;
+                    return -2;
+                }
+                moved_rows[m++] = i;
+            }
+        }
+        if (m > n / 4) bp->fat_count = -1;   /* most boxes left theirs: built anew */
+    }
+    if (bp->fat_count < 0) {
+        r = fat_build(w, boxes, margin);
+        if (r != 0) return r;
+        m = 0;
+    }
+    fat = (double *)bp->fat_boxes.p;
+    if (m > 0) {
+        int nf = 0, j, t;
+        /* the moved rows' new fat boxes, in the grid */
+        for (k = 0; k < m; ++k) {
+            double *f = &fat[4 * moved_rows[k]];
+            fat_of(&boxes[moved_rows[k]], bp->fat_grow, f);
+            if (!(f[0] > -INFINITY && f[2] < INFINITY && f[1] > -INFINITY && f[3] < INFINITY)) {
+                bp->fat_count = -1;
+                return -2;
+            }
+            if (lc_reach_grid_move(bp->fat_grid, moved_rows[k], f) != 0) {
+                bp->fat_count = -1;
+                return -1;
+            }
+        }
+        /* their fat pairs: each from the lower row when both moved */
+        for (k = 0; k < m; ++k) {
+            const int *near;
+            int a = moved_rows[k], q, nq = lc_reach_grid_query(bp->fat_grid, &fat[4 * a], &near);
+            if (nq < 0) {
+                bp->fat_count = -1;
+                return -1;
+            }
+            for (q = 0; q < nq; ++q) {
+                int b = near[q];
+                if (b == a || (moved[b] && b < a) || (w->is_static[a] && w->is_static[b])) continue;
+                if ((nn = add_pair(&bp->fat_new, nn, a, b)) < 0) {
+                    bp->fat_count = -1;
+                    return -1;
+                }
+            }
+        }
+        if (nn > 1) qsort(bp->fat_new.p, (size_t)nn, 2 * sizeof(int), cmp_pair);
+        /* the other fat pairs (neither row moved) stay, in order; the new ones merged in */
+        fp = lc_buf_get(&bp->fat_pairs, (size_t)(bp->fat_count + nn + 1) * 2 * sizeof(int));
+        if (fp == NULL) {
+            bp->fat_count = -1;
+            return -1;
+        }
+        for (k = 0; k < bp->fat_count; ++k)
+            if (!moved[fp[2 * k]] && !moved[fp[2 * k + 1]]) {
+                fp[2 * nf] = fp[2 * k];
+                fp[2 * nf + 1] = fp[2 * k + 1];
+                nf++;
+            }
+        i = nf - 1;
+        j = nn - 1;
+        for (t = nf + nn - 1; j >= 0; --t) {
+            const int *np = (const int *)bp->fat_new.p;
+            if (i >= 0 && pair_after(&fp[2 * i], &np[2 * j])) {
+                fp[2 * t] = fp[2 * i];
+                fp[2 * t + 1] = fp[2 * i + 1];
+                --i;
+            } else {
+                fp[2 * t] = np[2 * j];
+                fp[2 * t + 1] = np[2 * j + 1];
+                --j;
+            }
+        }
+        bp->fat_count = nf + nn;
+    }
+    /* the fat pairs whose boxes overlap */
+    fp = (int *)bp->fat_pairs.p;
+    out = lc_buf_get(buf, (size_t)(bp->fat_count + 1) * 2 * sizeof(int));
+    if (out == NULL) return -1;
+    for (k = 0; k < bp->fat_count; ++k) {
+        int a = fp[2 * k], b = fp[2 * k + 1];
+        if (!overlap(&boxes[a], &boxes[b])) continue;
+        out[2 * count] = a;
+        out[2 * count + 1] = b;
+        count++;
+    }
+    w->last.grid_steps++;
+    w->last.broadphase_pairs += (uint64_t)count;
+    return count;
+}
+
 int lc_broad_phase(lc_world *w, const double *s0, const double *s1, double margin, lc_buf *buf)
 {
     box *boxes;
@@ -518,7 +712,9 @@ int lc_broad_phase(lc_world *w, const double *s0, const double *s1, double margi
     }
     boxes = swept_boxes(w, s0, s1, margin);
     if (boxes == NULL) return -1;
-    count = pairs_of(w, boxes, buf);
+    count = -2;
+    if (s1 != s0 && choose(w, w->count) == LC_BROADPHASE_GRID) count = pairs_of_fat(w, boxes, margin, buf);
+    if (count == -2) count = pairs_of(w, boxes, buf);
     if (count >= 0 && s1 != s0) keep_search(w, s0, s1, margin, buf, count);
     return count;
 }

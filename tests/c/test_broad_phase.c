@@ -9,7 +9,8 @@
  * shuffle of positions, an interval with a different end state (swept boxes), and boxes stacked in
  * one column (every box overlaps every other in x) - and after each the pair list of sort-and-sweep
  * must equal brute force's entry for entry, with no tolerance: both test the same boxes. The grid's
- * list too (box_pairs.c: the floor is a wide box there, tested against the cells it covers), and also
+ * list too (box_pairs.c: the floor is a wide box there, tested against the cells it covers; over an
+ * interval, from the fat boxes it keeps between searches, checked over a run of intervals), and also
  * for boxes no grid cell holds (lc_broad_phase_boxes: a NaN, an infinite, an inverted box). So must the
  * pairs of lc_broad_phase_of (the pairs of a few listed bodies, after an impact) equal brute force's
  * pairs that have a listed body, also while the broad phase tracks an interval in its grid
@@ -230,6 +231,30 @@ int main(void)
     for (i = 1; i < rows; i++) s1[i * 6 + SX] += sc_uniform(&rng, -2.0, 2.0);
     compare(w, s0, s1, "swept over an interval", brute, sweep);
     compare_of(w, s0, s1, "swept over an interval", brute, sweep, &rng);
+    {
+        /* the grid keeps fat boxes from one interval search to the next: a run of intervals moving
+         * every box a little (most stay inside their fat boxes), a tenth of them far (new fat boxes
+         * and fat pairs), and once every box far (the fat boxes made anew) */
+        double *a0 = malloc((size_t)rows * 6 * sizeof(double)), *a1 = malloc((size_t)rows * 6 * sizeof(double));
+        int it, k;
+        CHECK(a0 && a1, "%s", "allocation");
+        if (a0 && a1) {
+            memcpy(a0, s1, (size_t)rows * 6 * sizeof(double));
+            for (it = 0; it < 12; ++it) {
+                memcpy(a1, a0, (size_t)rows * 6 * sizeof(double));
+                for (k = 1; k < rows; k++) {
+                    double d = it == 6 ? 3.0 : (k % 10 == it % 10 ? 1.5 : 0.05);
+                    a1[k * 6 + SX] += sc_uniform(&rng, -d, d);
+                    a1[k * 6 + SY] += sc_uniform(&rng, -d, d);
+                    a1[k * 6 + SA] += sc_uniform(&rng, -0.05, 0.05);
+                }
+                compare(w, a0, a1, "a run of intervals", brute, sweep);
+                memcpy(a0, a1, (size_t)rows * 6 * sizeof(double));
+            }
+        }
+        free(a0);
+        free(a1);
+    }
     {
         /* the interval's pairs taken at its end, then with bodies moved (the interval searched last) */
         int *dyn = malloc((size_t)rows * sizeof(int)), nd = 0, k;
