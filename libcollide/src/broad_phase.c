@@ -617,7 +617,7 @@ static int pairs_of_fat(lc_world *w, const box *boxes, double margin, lc_buf *bu
                 moved_rows[m++] = i;
             }
         }
-        if (m > n / 4) bp->fat_count = -1;   /* most boxes left theirs: built anew */
+        if (m > n / 4) bp->fat_count = -1;   /* past a quarter of the boxes out of theirs, built anew */
     }
     if (bp->fat_count < 0) {
         r = fat_build(w, boxes, margin);
