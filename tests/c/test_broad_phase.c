@@ -17,7 +17,7 @@
  * (lc_broad_phase_track): at a state inside the interval, and after a hundred bodies changed paths
  * (lc_broad_phase_retrack: their new boxes in the cells' lists beside the table), and after every path
  * changed three times more (past the entries at which the grid is built anew). A search at one state
- * after a search over an interval takes the interval's pairs where it can (pairs_from_kept): at the
+ * after a search over an interval takes the interval's pairs where it can (broad_phase_kept.c): at the
  * interval's end state, with a few bodies moved elsewhere while the interval is tracked, and with a
  * tracked body given a new path (retracked) but back at its end state, its pairs must be exactly brute
  * force's over the boxes at that state, in the same order, and no search of the world must have run;

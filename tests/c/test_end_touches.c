@@ -4,7 +4,7 @@
  * g = 9.81, dt = 1/60 s, a 1 m x 0.5 m, 1 kg box resting on a static floor.
  *  - reuse happens (the event regime's, so that regime is set): in a resting scene each step runs one
  *    whole-world broadphase for its islands and one for its trial (brute_force_steps = 2); the
- *    projection's search takes the trial's pairs (broad_phase.c, pairs_from_kept), and the resting set
+ *    projection's search takes the trial's pairs (broad_phase_kept.c), and the resting set
  *    at its start searches nothing: one candidate pair each for the islands, the trial and the
  *    projection (broadphase_pairs = 3, 4 without the reuse, whose search would find the pair again);
  *  - friction set after a step counts at once: a resting box with mu 0 -> 1 under a 2 N push stays
