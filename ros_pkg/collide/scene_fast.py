@@ -62,10 +62,11 @@ def _unique_keys(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
 
 def _read_json(text: str, max_depth: int, max_nodes: int) -> Any:
     # brackets bound the depth of the data, and keep json's recursive decoder far from the recursion limit;
-    # the line-numbered reader reads JSON as YAML, whose reader refuses characters that json takes
+    # the line-numbered reader reads JSON as YAML, whose reader refuses characters that json takes, and
+    # whose scanner refuses a tab between tokens where json takes it as a space (as _read_yaml says)
     if (json_nests_too_deep(text, max_depth + 1) or _JSON_SURROGATE.search(text)
-            or yaml.reader.Reader.NON_PRINTABLE.search(text)):
-        raise NotPlain("deep, surrogate escapes or a character PyYAML's reader refuses")
+            or yaml.reader.Reader.NON_PRINTABLE.search(text) or "\t" in text):
+        raise NotPlain("deep, surrogate escapes, a tab or a character PyYAML's reader refuses")
     try:
         data = json.loads(text, object_pairs_hook=_unique_keys)
     except (ValueError, RecursionError) as exc:  # JSONDecodeError is a ValueError
@@ -90,6 +91,11 @@ def _read_yaml(text: str, max_depth: int, max_nodes: int) -> Any:
         raise NotPlain("PyYAML without libyaml")
     if yaml.reader.Reader.NON_PRINTABLE.search(text):
         raise NotPlain("a character PyYAML's reader refuses")
+    # libyaml takes a tab as the space between tokens of a flow collection where PyYAML's own scanner
+    # refuses it ("found character '\t' that cannot start any token"): a file with a tab is the
+    # line-numbered reader's, which decides as it always does
+    if "\t" in text:
+        raise NotPlain("a tab")
     loader = yaml.CSafeLoader(text)
     try:
         return _compose(loader, max_depth, max_nodes)
