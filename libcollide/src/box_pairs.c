@@ -56,14 +56,6 @@ static int gridable(const double *b)
     return b[0] > -INFINITY && b[0] <= b[2] && b[2] < INFINITY && b[1] > -INFINITY && b[1] <= b[3] && b[3] < INFINITY;
 }
 
-/* The cell index of coordinate v along an axis of `cells` cells from origin o, clamped to the grid:
- * clamping keeps the order of interval ends, so two overlapping boxes still share a cell. */
-static int cell_of(double v, double o, double inv_cell, int cells)
-{
-    double f = (v - o) * inv_cell;   /* monotone in v, which is all the pairs need */
-    return f < 1.0 ? 0 : (f >= cells ? cells - 1 : (int)f);   /* (int) truncates: the floor of f >= 1 */
-}
-
 /* kind[k] of box k */
 enum { SMALL = 0, WIDE = 1, ODD = 2 };   /* in the table; over too many cells; not gridable */
 
@@ -118,10 +110,10 @@ int lc_box_pairs_find(lc_box_pairs *g, const void *boxes, size_t stride, int n,
             wide[nwide++] = k;
             continue;
         }
-        r[0] = cell_of(b[0], xmin, inv, nx);
-        r[1] = cell_of(b[1], ymin, inv, ny);
-        r[2] = cell_of(b[2], xmin, inv, nx);
-        r[3] = cell_of(b[3], ymin, inv, ny);
+        r[0] = lc_grid_cell_of(b[0], xmin, inv, nx);
+        r[1] = lc_grid_cell_of(b[1], ymin, inv, ny);
+        r[2] = lc_grid_cell_of(b[2], xmin, inv, nx);
+        r[3] = lc_grid_cell_of(b[3], ymin, inv, ny);
         if (b[2] - b[0] > span || b[3] - b[1] > span) {
             kind[k] = WIDE;
             wide[nwide++] = k;

@@ -106,7 +106,6 @@ double lc_bounds_gap(const lc_world *w, const double *state, int a, int b)
     return fmax(g, fmax(ba.y0 - bb.y1, bb.y0 - ba.y1));
 }
 
-
 /* A candidate pair when the two boxes overlap and not both bodies are static: count + 1, else count
  * (-1: no memory). */
 static int add_if_near(const lc_world *w, lc_buf *buf, int count, const box *x, const box *y)
@@ -116,7 +115,6 @@ static int add_if_near(const lc_world *w, lc_buf *buf, int count, const box *x, 
     if (!overlap(x, y)) return count;
     return add_pair(buf, count, x->row, y->row);
 }
-
 
 /* The boxes in cmp_box order. Bodies move little from one pass to the next, so the last sweep's order
  * is nearly sorted: an insertion sort from it is linear where qsort is n log n (the resting base-20

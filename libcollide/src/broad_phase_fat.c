@@ -55,13 +55,15 @@ static int finite_box(const box *b)
            b->y0 <= b->y1;
 }
 
-/* A box's fat box: grown by grow. */
-static void fat_of(const box *b, double grow, double f[4])
+/* A box's fat box, grown by grow; 0 when it is not finite (a box far out, beyond what a double's sum
+ * keeps finite: searched as it is). */
+static int fat_of(const box *b, double grow, double f[4])
 {
     f[0] = b->x0 - grow;
     f[1] = b->y0 - grow;
     f[2] = b->x1 + grow;
     f[3] = b->y1 + grow;
+    return f[0] > -INFINITY && f[2] < INFINITY && f[1] > -INFINITY && f[3] < INFINITY;
 }
 
 /* The fat pairs made anew: every row's fat box from its box, in the fat grid, and the pairs whose fat
@@ -82,11 +84,8 @@ static int fat_build(lc_bp_fat *bp, lc_world *w, lc_box_pairs *scratch, const bo
     }
     bp->fat_grow = n > 0 ? LC_FAT_GROW * ext / n : 0.0;
     for (i = 0; i < n; ++i) {
-        fat_of(&boxes[i], bp->fat_grow, &fat[4 * i]);
         rows[i] = i;
-        /* a box far out (beyond what a double's sum keeps finite) is searched as it is */
-        if (!(fat[4 * i] > -INFINITY && fat[4 * i + 2] < INFINITY && fat[4 * i + 1] > -INFINITY && fat[4 * i + 3] < INFINITY))
-            return -2;
+        if (!fat_of(&boxes[i], bp->fat_grow, &fat[4 * i])) return -2;
     }
     if (lc_reach_grid_build(bp->fat_grid, fat, rows, n, n) != 0) return -1;
     k.w = w;
@@ -140,12 +139,11 @@ int lc_bp_pairs_of_fat(lc_bp_fat *bp, lc_world *w, lc_box_pairs *scratch, const 
     }
     fat = (double *)bp->fat_boxes.p;
     if (m > 0) {
-        int nf = 0, j, t;
+        int nf = 0;
         /* the moved rows' new fat boxes, in the grid */
         for (k = 0; k < m; ++k) {
             double *f = &fat[4 * moved_rows[k]];
-            fat_of(&boxes[moved_rows[k]], bp->fat_grow, f);
-            if (!(f[0] > -INFINITY && f[2] < INFINITY && f[1] > -INFINITY && f[3] < INFINITY)) {
+            if (!fat_of(&boxes[moved_rows[k]], bp->fat_grow, f)) {
                 bp->fat_count = -1;
                 return -2;
             }
@@ -184,20 +182,7 @@ int lc_bp_pairs_of_fat(lc_bp_fat *bp, lc_world *w, lc_box_pairs *scratch, const 
                 fp[2 * nf + 1] = fp[2 * k + 1];
                 nf++;
             }
-        i = nf - 1;
-        j = nn - 1;
-        for (t = nf + nn - 1; j >= 0; --t) {
-            const int *np = (const int *)bp->fat_new.p;
-            if (i >= 0 && pair_after(&fp[2 * i], &np[2 * j])) {
-                fp[2 * t] = fp[2 * i];
-                fp[2 * t + 1] = fp[2 * i + 1];
-                --i;
-            } else {
-                fp[2 * t] = np[2 * j];
-                fp[2 * t + 1] = np[2 * j + 1];
-                --j;
-            }
-        }
+        merge_pairs(fp, nf, (const int *)bp->fat_new.p, nn);
         bp->fat_count = nf + nn;
     }
     /* the fat pairs whose boxes overlap */

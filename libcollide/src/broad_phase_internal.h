@@ -46,6 +46,24 @@ static inline int same_row(const double *a, const double *b) { return memcmp(a, 
 
 static inline int pair_after(const int *x, const int *y) { return x[0] > y[0] || (x[0] == y[0] && x[1] > y[1]); }
 
+/* Merges the sorted pairs add[0..nadd) into the sorted pairs p[0..count) (p holds count + nadd pairs),
+ * from the back: the two lists share no pair. */
+static inline void merge_pairs(int *p, int count, const int *add, int nadd)
+{
+    int i = count - 1, j = nadd - 1, t;
+    for (t = count + nadd - 1; j >= 0; --t) {
+        if (i >= 0 && pair_after(&p[2 * i], &add[2 * j])) {
+            p[2 * t] = p[2 * i];
+            p[2 * t + 1] = p[2 * i + 1];
+            --i;
+        } else {
+            p[2 * t] = add[2 * j];
+            p[2 * t + 1] = add[2 * j + 1];
+            --j;
+        }
+    }
+}
+
 /* ---- broad_phase.c ---- */
 /* Where body i can be between s0 and s1, grown by margin. */
 void lc_bp_swept_box(lc_world *w, const double *s0, const double *s1, int i, double margin, box *out);

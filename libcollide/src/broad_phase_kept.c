@@ -192,25 +192,11 @@ int lc_bp_pairs_from_kept(lc_bp_kept *bp, lc_world *w, lc_reach_grid *tracked, c
             }
     }
     if (nm > 0) {
-        int j, t;
         mp = (int *)bp->moved_pairs.p;
         if (nm > 1) qsort(mp, (size_t)nm, 2 * sizeof(int), cmp_pair);
         out = lc_buf_get(buf, (size_t)(count + nm) * 2 * sizeof(int));
         if (out == NULL) return -1;
-        /* merged from the back: the two lists are sorted and share no pair */
-        i = count - 1;
-        j = nm - 1;
-        for (t = count + nm - 1; j >= 0; --t) {
-            if (i >= 0 && pair_after(&out[2 * i], &mp[2 * j])) {
-                out[2 * t] = out[2 * i];
-                out[2 * t + 1] = out[2 * i + 1];
-                --i;
-            } else {
-                out[2 * t] = mp[2 * j];
-                out[2 * t + 1] = mp[2 * j + 1];
-                --j;
-            }
-        }
+        merge_pairs(out, count, mp, nm);
         count += nm;
     }
     w->last.broadphase_pairs += (uint64_t)count;

@@ -1,5 +1,5 @@
-/* The shape of a uniform grid over boxes (box_pairs.c, reach_grid.c): its cell size and its columns and
- * rows. */
+/* The shape of a uniform grid over boxes (box_pairs.c, reach_grid.c): its cell size, its columns and
+ * rows, and the cell of a coordinate. */
 #ifndef LC_GRID_SHAPE_H
 #define LC_GRID_SHAPE_H
 
@@ -24,6 +24,17 @@ static inline int lc_grid_shape(double xmin, double ymin, double xmax, double ym
         }
         c *= 2.0;
     }
+}
+
+/* The cell of coordinate v along an axis of `cells` cells from origin o (inv: 1 / cell), clamped to the
+ * grid. Any mapping monotone in v serves, as long as a grid's builds, moves and queries share it:
+ * clamping keeps the order of interval ends, so two overlapping boxes still share a cell. The product
+ * by 1 / cell is monotone, and the cast truncates, which is the floor from 1 up: no call to floor and
+ * no division, for a map of every box of a build. */
+static inline int lc_grid_cell_of(double v, double o, double inv, int cells)
+{
+    double f = (v - o) * inv;
+    return f < 1.0 ? 0 : (f >= cells ? cells - 1 : (int)f);
 }
 
 #endif

@@ -59,23 +59,13 @@ void lc_reach_grid_destroy(lc_reach_grid *g)
     free(g);
 }
 
-/* The cell of coordinate v along an axis of `cells` cells from origin o, clamped to the grid. Any
- * mapping monotone in v serves, as long as the build, the moves and the queries share it (two
- * overlapping intervals then share a cell): the product by 1 / cell is, and the cast truncates, which
- * is the floor from 1 up. No call to floor and no division: a build maps every row's box. */
-static int cell_of(double v, double o, double inv, int cells)
-{
-    double f = (v - o) * inv;
-    return f < 1.0 ? 0 : (f >= cells ? cells - 1 : (int)f);
-}
-
 /* The cell range [i0, i1] x [j0, j1] a box covers, clamped to the grid. */
 static void cell_range(const lc_reach_grid *g, const double *b, int *i0, int *j0, int *i1, int *j1)
 {
-    *i0 = cell_of(b[0], g->x0, g->inv, g->nx);
-    *j0 = cell_of(b[1], g->y0, g->inv, g->ny);
-    *i1 = cell_of(b[2], g->x0, g->inv, g->nx);
-    *j1 = cell_of(b[3], g->y0, g->inv, g->ny);
+    *i0 = lc_grid_cell_of(b[0], g->x0, g->inv, g->nx);
+    *j0 = lc_grid_cell_of(b[1], g->y0, g->inv, g->ny);
+    *i1 = lc_grid_cell_of(b[2], g->x0, g->inv, g->nx);
+    *j1 = lc_grid_cell_of(b[3], g->y0, g->inv, g->ny);
 }
 
 static int is_wide(const lc_reach_grid *g, const double *b)
