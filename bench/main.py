@@ -3,11 +3,13 @@ error on the seed and hard-case scenes (docs/benchmarks.md). Use bench/run (it i
 
     bench/run [--quick | --full] [--sections wp,ref,impacts,cradle,tunnel,stacks,hard,pyramid,scaling]
     bench/run [--quick] --sections contact [--seeds 1,2,3]   # piles, pushing, friction (bench/contact.py)
+    bench/run [--quick] --sections contact_wp   # the peers' accuracy knobs on those scenes (bench/contact_wp.py)
 
 Writes docs/benchmarks.md, docs/img/bench_*.png and bench/results/latest.json (and the results behind each
-page it writes: bench/results/benchmarks.json, bench_contact.json). The contact section is
+page it writes: bench/results/benchmarks.json, bench_contact.json, bench_contact_wp.json). The contact section is
 not in the default list; it writes docs/bench_contact.md, and docs/benchmarks.md only when other
-sections ran too (a run of it alone leaves that page as it is)."""
+sections ran too (a run of it alone leaves that page as it is). contact_wp writes its own section of
+docs/bench_contact.md and docs/img/bench_contact_wp.png."""
 from __future__ import annotations
 
 import argparse
@@ -25,10 +27,12 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 
 import contact  # noqa: E402
+import contact_wp  # noqa: E402
 import harness  # noqa: E402
 import metrics  # noqa: E402
 import report  # noqa: E402
 import report_contact  # noqa: E402
+import report_contact_wp  # noqa: E402
 import scenes  # noqa: E402
 from harness import Task  # noqa: E402
 
@@ -362,6 +366,13 @@ class Bench:
         self.out["contact"] = contact.run_section(self.pool, list(contact.SCENE_KEYS), contact.ENGINES,
                                                   self.repeats, budget, log, seeds, self.quick)
 
+    def contact_wp(self) -> None:
+        """Work-precision of the contact scenes: the peers' substeps, iterations, slop and dt turned up,
+        libcollide at its defaults (bench/contact_wp.py). --quick: 1 repeat, each random pile's first seed."""
+        given = self.args.seeds or contact_wp.SEEDS["mixed30"]   # mixed100 (one seed by default) takes the first
+        seeds = {k: given[:1] if self.quick or len(v) == 1 else given for k, v in contact_wp.SEEDS.items()}
+        self.out["contact_wp"] = contact_wp.run_section(self.pool, list(contact_wp.SCENES), self.repeats, log, seeds)
+
 
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -369,7 +380,7 @@ def main() -> int:
     g.add_argument("--quick", action="store_true", help="smoke run of a few seconds (1 seed, 1 repeat, short scenes)")
     g.add_argument("--full", action="store_true", help="more repeats, larger scenes, longer budgets")
     ap.add_argument("--sections", default="wp,ref,impacts,cradle,tunnel,stacks,hard,pyramid,scaling",
-                    help="comma list; also 'contact' (not run by default: docs/bench_contact.md)")
+                    help="comma list; also 'contact' and 'contact_wp' (not run by default: docs/bench_contact.md)")
     ap.add_argument("--out", default=os.path.join(ROOT, "docs", "benchmarks.md"),
                     help="markdown file to write; the plots go to img/ next to it")
     ap.add_argument("--budget", type=float, help="CPU seconds per run before it is stopped (default 15, quick 4, "
@@ -402,12 +413,19 @@ def main() -> int:
     save_results(b.out, "latest.json")
     if not args.no_report:
         docs = os.path.dirname(os.path.abspath(args.out))
-        if any(sec.strip() != "contact" for sec in args.sections.split(",")):
+        if any(sec.strip() not in ("contact", "contact_wp") for sec in args.sections.split(",")):
             report.write(b.out, args.out, os.path.join(docs, "img"))
             log(f"wrote {args.out}")
             # the data behind this page's figures, kept until the page is written again
             # (python bench/report.py --replot redraws them from it)
             save_results(b.out, os.path.splitext(os.path.basename(args.out))[0] + ".json")
+        if "contact_wp" in b.out:   # its section of docs/bench_contact.md, kept when the contact section rewrites the page
+            wp = {"meta": b.out["meta"], "contact_wp": b.out["contact_wp"]}
+            save_results(wp, "bench_contact_wp.json")
+            report_contact_wp.plot(b.out["contact_wp"], os.path.join(docs, "img", report_contact_wp.FIGURE))
+            if "contact" not in b.out:
+                report_contact_wp.update_page(wp, os.path.join(docs, "bench_contact.md"))
+                log(f"wrote its section of {os.path.join(docs, 'bench_contact.md')}")
         if "contact" in b.out:   # a page of its own: report.write rewrites the whole of args.out
             report_contact.write_contact(b.out, os.path.join(docs, "bench_contact.md"))
             log(f"wrote {os.path.join(docs, 'bench_contact.md')}")

@@ -187,9 +187,13 @@ def contact_notes(sec: dict[str, Any]) -> list[str]:
     return L
 
 
-def write_contact(out: dict[str, Any], path: str) -> None:
+WP_RESULTS = os.path.join(HERE, "results", "bench_contact_wp.json")
+
+
+def write_contact(out: dict[str, Any], path: str, wp_results: str = WP_RESULTS) -> None:
     """docs/bench_contact.md: the contact section of a bench/run run, on a page of its own so that a
-    run of this section alone leaves docs/benchmarks.md as it is."""
+    run of this section alone leaves docs/benchmarks.md as it is. The work-precision section
+    (bench/contact_wp.py) is redrawn at the end from wp_results, the JSON of its last run, if there is one."""
     sec = out["contact"]
     meta = out.get("meta", {})
     L = ["# Benchmarks: contact scenes (piles, pushing, friction)", "",
@@ -212,5 +216,10 @@ def write_contact(out: dict[str, Any], path: str) -> None:
     L += [f"- **{key}** (" + ", ".join(f"`{n}`" for n in s.get("names", [s["name"]])) + f"): {s['what']}"
           for key, s in sec["scenes"].items()]
     L += [""] + contact_table(sec) + [""] + contact_notes(sec) + [""]
+    if os.path.exists(wp_results):
+        import json
+        import report_contact_wp
+        with open(wp_results) as fh:
+            L += report_contact_wp.section(json.load(fh)) + [""]
     with open(path, "w") as fh:
         fh.write("\n".join(L))
