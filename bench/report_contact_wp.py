@@ -2,7 +2,8 @@
 sentences that read the table (each from the numbers: how far each peer's overlap and energy gain fall
 and at what cost), and the figure. The section sits between two markers so that either writer of the
 page keeps it: bench/run --sections contact_wp replaces it in place, and report_contact.write_contact
-(bench/run --sections contact) regenerates it from bench/results/bench_contact_wp.json."""
+(bench/run --sections contact) regenerates it from bench/results/bench_contact_wp.json, and so does
+`python bench/report_contact_wp.py` (with the figure; no engine runs)."""
 from __future__ import annotations
 
 import math
@@ -78,12 +79,58 @@ def findings(sec: dict[str, Any], key: str) -> list[str]:
             text = (f"- {name}, {what}: smallest {show(best[measure])} ({_where(best, lc_us)}); at the costliest "
                     "setting of each series " + "; ".join(f"{show(p[measure])} ({_where(p, lc_us)})" for p in ends)
                     + "; ")
+            at_frame = [p for p in pts if math.isclose(p["dt"], sec["frame_dt"])]
+            if measure == "max_overlap" and at_frame:
+                knobs = "substep count or contact_hertz" if eng == "box2d3" else "iteration count or slop"
+                low = min(at_frame, key=lambda p: p[measure])
+                text += (f"at dt 1/60 it does not fall below {show(low[measure])} at any {knobs} measured "
+                         f"(range {show(low[measure])}-{show(max(p[measure] for p in at_frame))}); ")
             if hit is None:
                 text += f"no setting measured reaches {show(target)} (libcollide's level here)."
             else:
                 text += f"≤ {show(target)} (libcollide's level here) first at {_where(hit, lc_us)}."
             L.append(text)
     return L
+
+
+def _best_cell(points: list[dict[str, Any]], engine: str, measure: str, lc_us: float) -> str:
+    """The smallest value of a measure over an engine's points, with its setting, cost and cost ratio."""
+    pts = _ok(points, engine, measure)
+    if not pts:
+        return "—"
+    p = min(pts, key=lambda q: q[measure])
+    value = f"{p[measure] * 1e3:.3g}" if measure == "max_overlap" else f"{p[measure]:+.2g}"
+    ratio = p["us_per_frame"] / lc_us if lc_us and math.isfinite(lc_us) else math.nan
+    return f"{value} ({_short(p)}; {f(p['us_per_frame'], '.4g')} µs, {f(ratio, '.3g')}×)"
+
+
+def _short(p: dict[str, Any]) -> str:
+    """A point's setting in a few words: its knob with the settings its series holds fixed."""
+    st = p.get("settings") or {}
+    if p["engine"] == "pymunk":
+        return f"{p['knob']}" + (", 10 iterations" if "iterations" not in p["knob"] else "") + \
+            f", slop {st.get('collision_slop', math.nan) * 1e3:g} mm"
+    if p["engine"] == "box2d3" and "substeps" not in p["knob"]:
+        return f"{st.get('substeps', '?')} substeps, {p['knob']}"
+    return p["knob"]
+
+
+def summary_table(sec: dict[str, Any]) -> list[str]:
+    """One row per scene: libcollide's cost and quality, and each peer's smallest max overlap and
+    smallest worst energy gain over all its settings, each with where and at what cost."""
+    head = ["scene", "libcollide µs per 1/60 s", "libcollide overlap mm / ΔE/E"]
+    for eng in PEERS:
+        head += [f"{CONTACT_NAMES[eng]} smallest overlap mm (setting; µs, × libcollide)",
+                 f"{CONTACT_NAMES[eng]} smallest worst ΔE/E (setting; µs, × libcollide)"]
+    rows = []
+    for key, s in sec["scenes"].items():
+        lc = next((p for p in s["points"] if p["engine"] == "libcollide" and p.get("kind") == "ok"), None)
+        lc_us = lc["us_per_frame"] if lc else math.nan
+        row = [key, f(lc_us, ".4g"), "—" if lc is None else f"{lc['max_overlap'] * 1e3:.3g} / {lc['max_step_gain']:+.2g}"]
+        for eng in PEERS:
+            row += [_best_cell(s["points"], eng, "max_overlap", lc_us), _best_cell(s["points"], eng, "max_step_gain", lc_us)]
+        rows.append(row)
+    return md_table(head, rows)
 
 
 def _sink_cell(p: dict[str, Any]) -> str:
@@ -148,6 +195,8 @@ def section(wp: dict[str, Any]) -> list[str]:
          f"Chipmunk: iterations 10-160 with collision_slop 5 mm and 0, and 10 iterations at dt {_small_dts(sec, 'pymunk')}. "
          f"\"libcollide's level here\" = libcollide's figure in the same run, or {OVERLAP_TARGET:g} m overlap / "
          f"{GAIN_TARGET:g} energy gain if that is larger.", "",
+         "Smallest value each peer reaches over all its settings (the figure and the tables below have every point):",
+         ""] + summary_table(sec) + ["",
          f"![CPU per 1/60 s against max overlap and worst energy gain, per scene](img/{FIGURE})", ""]
     for key, s in sec["scenes"].items():
         L += [_scene_title(key, s) + f": {s['what']}", ""] + findings(sec, key) + [""] + scene_table(sec, key) + [""]
@@ -217,3 +266,18 @@ def plot(sec: dict[str, Any], path: str) -> None:
     os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
     fig.savefig(path, dpi=90)
     plt.close(fig)
+
+
+def main() -> int:
+    """Redraws the section of docs/bench_contact.md and the figure from the last run's JSON, no engine run."""
+    import json
+    root = os.path.dirname(HERE)
+    with open(os.path.join(HERE, "results", "bench_contact_wp.json")) as fh:
+        wp = json.load(fh)
+    plot(wp["contact_wp"], os.path.join(root, "docs", "img", FIGURE))
+    update_page(wp, os.path.join(root, "docs", "bench_contact.md"))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
