@@ -190,8 +190,8 @@ def section(wp: dict[str, Any]) -> list[str]:
          "repeats, so a run at dt 1/240 counts four steps. States are read every 1/60 s in every run: max overlap "
          "is taken at the same instants for every point and the worst energy gain is per 1/60 s. Box2D v3 series: "
          "substeps 4-64 at its default contact stiffness (contact_hertz 30, damping ratio 10, push speed 3 m/s) "
-         "and with contact_hertz at a quarter of the substep rate (the most Box2D accepts: it clamps higher "
-         f"values), and 4 substeps at dt {_small_dts(sec, 'box2d3')}; its linear slop (5 mm) is compiled in. "
+         "and with contact_hertz at an eighth of the substep rate (the stiffest it applies: its step clamps "
+         f"larger values to that), and 4 substeps at dt {_small_dts(sec, 'box2d3')}; its linear slop (5 mm) is compiled in. "
          f"Chipmunk: iterations 10-160 with collision_slop 5 mm and 0, and 10 iterations at dt {_small_dts(sec, 'pymunk')}. "
          f"\"libcollide's level here\" = libcollide's figure in the same run, or {OVERLAP_TARGET:g} m overlap / "
          f"{GAIN_TARGET:g} energy gain if that is larger.", "",

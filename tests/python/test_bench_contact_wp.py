@@ -71,7 +71,7 @@ def test_cost_is_per_frame_and_seeds_take_the_median(wp: ModuleType) -> None:
     # the median of seeds 2 and 4 (20 and 40 µs per step), per 1/60 s
     assert all(math.isclose(p["us_per_frame"], 30.0 / (60 * p["dt"])) for p in mixed["points"])
     stiff = [v for v in vs if v.series == "Box2D v3 substeps, contact_hertz max"]
-    assert stiff and all(v.settings["contact_hertz"] == 15 * v.settings["substeps"] for v in stiff)
+    assert stiff and all(v.settings["contact_hertz"] == 7.5 * v.settings["substeps"] for v in stiff)
 
 
 def _pt(engine: str, series: str, knob: str, us: float, overlap: float, gain: float) -> dict:
