@@ -68,7 +68,8 @@ KIND_RANK = {"ok": 0, "over budget": 1, "failed": 2}
 # with the fields that locate it in that seed's run
 WORST_OF: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("max_overlap", ("overlap_sample", "overlap_pair")), ("escaped", ("escape_sample",)),
-    ("max_step_gain", ("gain_step",)), ("sink_end", ()), ("sink_max", ()), ("creep", ()))
+    ("max_step_gain", ("gain_step",)), ("sink_end", ()), ("sink_max", ()), ("creep", ()),
+    ("end_motion_median", ("end_motion_max", "end_speed_max")))
 
 
 @dataclass(frozen=True)
@@ -179,7 +180,8 @@ def summarize(cs: ContactScene, r: dict[str, Any]) -> dict[str, Any]:
     if states is not None and len(states) >= 2:
         good = finite_prefix(np.asarray(states))
         if len(good) >= 2:
-            row.update(metrics.contact_metrics(cs.scene, {"states": good}, cs.inner, cs.at_rest))
+            row.update(metrics.contact_metrics(cs.scene, {"states": good}, cs.inner, cs.at_rest,
+                                                window=round(1.0 / DT)))
             row["samples"] = len(good)
     return row
 

@@ -294,12 +294,27 @@ def sink_creep(states: np.ndarray) -> dict[str, Any]:
             "creep": float(np.max(np.abs(s[:, :, 0] - s[0, :, 0])))}
 
 
+def end_motion(states: np.ndarray, window: int) -> dict[str, Any]:
+    """Whether a pile has come to rest by the end of a run sampled every step: each body's centre
+    displacement over the last `window` samples (1 s at dt 1/60), its median over the bodies
+    (`end_motion_median`, m) and largest (`end_motion_max`), and the largest centre speed in the last
+    sample (`end_speed_max`, m/s). A pile at rest moves by round-off; a creeping one by its creep."""
+    s = np.asarray(states)
+    if len(s) <= window:
+        return {}
+    d = np.hypot(s[-1, :, 0] - s[-1 - window, :, 0], s[-1, :, 1] - s[-1 - window, :, 1])
+    return {"end_motion_median": float(np.median(d)), "end_motion_max": float(np.max(d)),
+            "end_speed_max": float(np.max(np.hypot(s[-1, :, 3], s[-1, :, 4])))}
+
+
 def contact_metrics(scene: Any, res: dict[str, Any], inner: tuple[float, float, float, float],
-                    at_rest: bool) -> dict[str, Any]:
+                    at_rest: bool, window: int = 60) -> dict[str, Any]:
     """The contact section's quality measures of one run (states sampled every step): max_overlap,
-    escaped, energy_steps, and sink_creep where the scene starts at rest with its top box last."""
+    escaped, energy_steps, end_motion over the last `window` samples, and sink_creep where the scene
+    starts at rest with its top box last."""
     s = res["states"]
-    out = {**max_overlap(scene, s), **escaped_bodies(s, inner), **energy_steps(scene, s)}
+    out = {**max_overlap(scene, s), **escaped_bodies(s, inner), **energy_steps(scene, s),
+           **end_motion(s, window)}
     if at_rest:
         out.update(sink_creep(s))
     return out

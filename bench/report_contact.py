@@ -78,6 +78,14 @@ def _sink_cell(r: dict[str, Any] | None) -> str:
     return f"{r['sink_end'] * 1e3:.3g} / {r['sink_max'] * 1e3:.3g} / {r['creep'] * 1e3:.3g}"
 
 
+def _motion_cell(r: dict[str, Any] | None) -> str:
+    if r is None or "end_motion_median" not in r:
+        return "—"
+    seed = _seed_of(r, "end_motion_median_seed")
+    return (f"{r['end_motion_median'] * 1e3:.2g} / {r['end_motion_max'] * 1e3:.2g} / "
+            f"{r['end_speed_max']:.2g}{' (' + seed[2:] + ')' if seed else ''}")
+
+
 def _scene_cell(key: str, s: dict[str, Any]) -> str:
     seeds = s.get("seeds")
     which = f"; seed{'s' if len(seeds) > 1 else ''} {','.join(map(str, seeds))}" if seeds else ""
@@ -96,7 +104,8 @@ def contact_table(sec: dict[str, Any]) -> list[str]:
     head += [f"libcollide / {CONTACT_NAMES[p]}" for p in peers]
     for e in engines:
         n = CONTACT_NAMES[e]
-        head += [f"{n}: max overlap mm (step)", f"{n}: escaped", f"{n}: worst step ΔE/E (step)"]
+        head += [f"{n}: max overlap mm (step)", f"{n}: escaped", f"{n}: worst step ΔE/E (step)",
+                 f"{n}: last 1 s median / max motion mm, end speed m/s"]
         head += [f"{n}: sink end / max, creep mm"] if sinks else []
     body = []
     for key, s in sec["scenes"].items():
@@ -105,7 +114,7 @@ def contact_table(sec: dict[str, Any]) -> list[str]:
         cells += [_ratio_cell(by_eng.get("libcollide"), p) for p in peers]
         for e in engines:
             r = by_eng[e]
-            cells += [_overlap_cell(r), _escaped_cell(r), _gain_cell(r)]
+            cells += [_overlap_cell(r), _escaped_cell(r), _gain_cell(r), _motion_cell(r)]
             cells += [_sink_cell(r) if s["at_rest"] else ""] if sinks else []
         body.append(cells)
     return md_table(head, body)
@@ -156,7 +165,9 @@ def contact_notes(sec: dict[str, Any]) -> list[str]:
          "top for pyramids and the stack) at some step. worst step ΔE/E = largest (E[k+1] − E[k]) / |E[k]|, "
          "E = KE + m g y (no scene here is driven, so > 0 is energy made by the solver; float32 Box2D "
          "states round at ~1e-7). sink = y₀ − y of the top box at the end / its largest; creep = "
-         "largest |x − x₀| of any box. The quality of a run that stopped early covers the steps it did. "
+         "largest |x − x₀| of any box. last 1 s motion = each body's centre displacement over the run's last "
+         "second, its median over the bodies / its largest, and the largest centre speed at the end: a pile "
+         "at rest moves by round-off, one that creeps by its creep. The quality of a run that stopped early covers the steps it did. "
          "Reading the states after every step puts each step in its own timed call: about 1 µs of clock "
          "reading per step is in every engine's figure.", "",
          f"Settings: dt {sec['dt']:.6g} s; " + "; ".join(f"{CONTACT_NAMES[e]} {v or 'adapter defaults'}"

@@ -326,3 +326,17 @@ def test_each_engine_runs_the_same_seeds_interleaved(contact: ModuleType) -> Non
     assert contact.parse_seeds(" 3, 1 ") == (3, 1)
     with pytest.raises(SystemExit):
         contact.parse_seeds("1,1")
+
+
+def test_end_motion_is_each_bodys_displacement_over_the_last_window() -> None:
+    scene = _scene(sc.Box(1.0, 1.0, 0.0, 0.0), sc.Box(1.0, 1.0, 2.0, 0.0), sc.Box(1.0, 1.0, 4.0, 0.0))
+    states = np.repeat(scene.initial_state()[None], 5, axis=0)
+    states[0, 0, 0] += 7.0                       # before the window: not counted
+    states[4, 1, 1] -= 0.003                     # 3 mm down in the window's last sample
+    states[4, 2, 0] += 0.004                     # 4 mm along x
+    states[4, 2, 3] = 0.5                        # the end speed
+    r = m.end_motion(states, 3)
+    assert math.isclose(r["end_motion_median"], 0.003, rel_tol=1e-9)
+    assert math.isclose(r["end_motion_max"], 0.004, rel_tol=1e-9)
+    assert r["end_speed_max"] == 0.5
+    assert m.end_motion(states, 5) == {}         # a run no longer than the window has no measure
