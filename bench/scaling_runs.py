@@ -110,7 +110,7 @@ def plot(sr: dict[str, Any], path: str, names: dict[str, str], colors: dict[str,
     bx.minorticks_off()
     bx.set_xlabel("dynamic bodies")
     bx.grid(True, which="major", alpha=0.3)
-    bx.legend(fontsize=7, loc="upper left")
+    bx.legend(fontsize=7, loc="lower right")
     fig.tight_layout()
     fig.savefig(path)
     plt.close(fig)
@@ -166,9 +166,10 @@ def section(sr: dict[str, Any], rel: str, names: dict[str, str], results: str = 
                  f"{pb['median']:.2f} ({pb['lo']:.2f}-{pb['hi']:.2f}) | {r['ratio_runs']}/{r['runs']} |")
     sp, at_lo, at_hi = spread(agg)
     top = [r for r in agg if r["n"] >= 5000]
-    L += ["", f"libcollide's median cost per block is highest at {at_hi} blocks and lowest at {at_lo}: "
+    L += ["", f"libcollide's median cost per block is highest at {_num(at_hi)} blocks and lowest at {_num(at_lo)}: "
           f"{sp:.2f}x apart ({'within' if sp <= WINDOW else 'outside'} the {WINDOW:g}x window)."
-          + "".join(f" At {r['n']} blocks it costs {r['ratio']['median']:.2f}x {short} (median ratio)." for r in top),
+          + "".join(f" At {_num(r['n'])} blocks it costs {r['ratio']['median']:.2f}x {short} (median ratio)."
+                    for r in top),
           END]
     return L
 
