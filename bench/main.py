@@ -20,7 +20,7 @@ import os
 import platform
 import sys
 import time
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 
@@ -343,12 +343,16 @@ class Bench:
         return ALL if not self.args.engines else \
             ("libcollide",) + tuple(e for e in PEERS if e in self.args.engines.split(","))
 
-    def scaling_rows(self, ns: list[int], engs: tuple[str, ...]) -> list[dict[str, Any]]:
-        """One run of the scaling section: a row per engine and body count (n = 0 included)."""
+    def scaling_rows(self, ns: list[int], engs: tuple[str, ...],
+                     laps_for: Callable[[int], int] | None = None) -> list[dict[str, Any]]:
+        """One run of the scaling section: a row per engine and body count (n = 0 included); laps_for(n),
+        when given, is how many times a timed repeat runs the n-body scene (Task.laps, the same for
+        every engine)."""
         # n = 0: one static box only, i.e. the per-step floor of each engine and its Python binding
         empty = scenes.Scene("many0", (scenes.Box(1.0, 1.0, 0.0, 0.0, static=True),), duration=10.0)
         tasks = [Task(eng, empty, 1 / 60, {}, None, self.budget) for eng in engs]
-        tasks += [Task(eng, scenes.many(n), 1 / 60, {}, None, self.budget) for n in ns for eng in engs]
+        tasks += [Task(eng, scenes.many(n), 1 / 60, {}, None, self.budget, laps=laps_for(n) if laps_for else 1)
+                  for n in ns for eng in engs]
         log(f"scaling: {len(tasks)} runs")
         res = self.run(tasks)
         rows = []
@@ -375,10 +379,11 @@ class Bench:
                 self.pool = harness.Pool()
             run: dict[str, Any] = {"start": _utc(), "load_before": os.getloadavg()}
             log(f"scaling run {i + 1}/{k}")
-            run["rows"] = self.scaling_rows(ns, engs)
+            run["rows"] = self.scaling_rows(ns, engs, scaling_runs.laps_for)
             run.update(end=_utc(), load_after=os.getloadavg())
             runs.append(run)
-        self.out["scaling_runs"] = {"peer": engs[1], "n": ns, "command": command, "runs": runs}
+        self.out["scaling_runs"] = {"peer": engs[1], "n": ns, "command": command, "runs": runs,
+                                    "body_steps": scaling_runs.BODY_STEPS}
 
     # ---- contact: piles, pushing, friction (bench/contact.py) ----------------------------------
     def contact(self) -> None:

@@ -8,8 +8,14 @@ docs/benchmarks.md that shows them.
 One run of the section gives each count's median of its repeats; a shared VM moves that by tens of
 per cent from one run to the next, so the comparison is the median over K runs with the range beside
 it, and the ratio to the peer is the median of the runs' own ratios (both engines of a run saw the same
-load). The block sits between BEGIN and END in the page: a run of this mode rewrites only it, and a
-full report writes it from the stored results (bench/results/scaling_runs.json)."""
+load). A timed repeat runs the scene (its 1 s, 60 steps) laps_for(n) times from a fresh build and
+sums the CPU, the same laps for both engines, so that every count times at least BODY_STEPS
+body-steps: one lap of 100 blocks is ~3 ms of CPU, too short for a stable figure. Laps, not a longer
+scene, because the cost per step is not the same later on: the blocks start on a grid, and
+bench/repro/probe_scaling.c's instructions per block and step at 100 blocks are 3 557 over steps 2-60,
+4 136 over 61-120 and 3 153 over 3 001-6 000 (cachegrind; docs/benchmarks.md). The block sits
+between BEGIN and END in the page: a run of this mode rewrites only it, and a full report writes it
+from the stored results (bench/results/scaling_runs.json)."""
 from __future__ import annotations
 
 import math
@@ -24,6 +30,13 @@ PLOT = "bench_scaling_per_body.png"
 RESULTS = "scaling_runs.json"
 WINDOW = 1.5    # issue 27: CPU per body and step within 1.5x over the range, <= 1.5x Box2D v3 at the top
 LC = "libcollide"
+BODY_STEPS = 1_000_000   # per timed repeat: about 0.5 s of CPU (one lap of 20 000 blocks is 1.2e6)
+LAP_STEPS = 60           # the scene's 1 s at dt 1/60
+
+
+def laps_for(n: int, body_steps: int = BODY_STEPS, lap_steps: int = LAP_STEPS) -> int:
+    """Laps of one timed repeat at n bodies: the fewest with n x lap_steps x laps >= body_steps, at least 1."""
+    return max(1, -(-body_steps // (max(n, 1) * lap_steps)))
 
 
 def _ok_us(rows: list[dict[str, Any]], engine: str, n: int) -> float | None:
@@ -47,7 +60,10 @@ def aggregate(runs: list[list[dict[str, Any]]], peer: str) -> list[dict[str, Any
         lc = [_ok_us(rows, LC, n) for rows in runs]
         pe = [_ok_us(rows, peer, n) for rows in runs]
         ratios = [a / b for a, b in zip(lc, pe) if a is not None and b is not None and b > 0]
-        row: dict[str, Any] = {"n": n, "runs": len(runs), "ratio_runs": len(ratios)}
+        laps = {(int(r.get("laps", 1)), int(r["steps"]) // int(r.get("laps", 1))) for rows in runs for r in rows
+                if r.get("n") == n and r.get("status") == "ok" and r.get("steps")}
+        row: dict[str, Any] = {"n": n, "runs": len(runs), "ratio_runs": len(ratios),
+                               "laps": sorted(laps)}   # (laps, steps per lap): one pair when all runs agree
         for key, vals in ((LC, lc), (peer, pe)):
             ok = [v for v in vals if v is not None]
             row[key] = _stats(ok)
@@ -63,9 +79,10 @@ def _stats(vals: list[float]) -> dict[str, float]:
     return {"median": float(np.median(vals)), "lo": min(vals), "hi": max(vals), "count": len(vals)}
 
 
-def spread(agg: list[dict[str, Any]]) -> tuple[float, int, int]:
-    """libcollide's highest over its lowest median cost per body (and the counts where they are)."""
-    pb = [(r[LC + "_per_body"]["median"], r["n"]) for r in agg if math.isfinite(r[LC + "_per_body"]["median"])]
+def spread(agg: list[dict[str, Any]], engine: str = LC) -> tuple[float, int, int]:
+    """engine's highest over its lowest median cost per body (and the counts where they are)."""
+    pb = [(r[engine + "_per_body"]["median"], r["n"]) for r in agg
+          if math.isfinite(r[engine + "_per_body"]["median"])]
     if not pb:
         return math.nan, 0, 0
     lo, hi = min(pb), max(pb)
@@ -124,6 +141,10 @@ def _num(x: float) -> str:
     return f"{x:.3g}" if x < 1000 else f"{round(x):,}".replace(",", " ")
 
 
+def _int(x: int) -> str:
+    return f"{x:,}".replace(",", " ")
+
+
 def _load(x: Any) -> str:
     try:
         return "/".join(f"{v:.1f}" for v in x)
@@ -144,31 +165,41 @@ def section(sr: dict[str, Any], rel: str, names: dict[str, str], results: str = 
     meta = sr.get("meta", {})
     runs = sr["runs"]
     k = len(runs)
-    steps = next((r["steps"] for run in runs for r in run["rows"] if r.get("n") and r.get("steps")), "?")
     short = names[peer].split(" (")[0]
+    if "body_steps" in sr:
+        length = (f"; a timed repeat runs the scene's 1 s (60 steps) from a fresh build as many times as "
+                  f"n × steps ≥ {_int(sr['body_steps'])} body-steps needs and sums the CPU "
+                  "(`scaling_runs.laps_for`, the same laps for both engines: the steps column)")
+    else:   # results of a run that took every count's scene once
+        length = " (steps column)"
     L = [BEGIN, f"### The current library against {short}", "",
          f"This block has runs of its own, apart from the rest of the page: the scaling section with "
          f"libcollide and {names[peer]} in the same run, {k} times: "
          f"`{sr.get('command', '?')}`, {_span(runs[0].get('start', '?'), runs[-1].get('end', '?'))}, "
          f"libcollide {meta.get('libcollide', '?')}, {meta.get('cpus', '?')} × {meta.get('cpu_model', '?')}, "
          f"load average before/after {_load(runs[0].get('load_before'))} / {_load(runs[-1].get('load_after'))} "
-         f"(each run's in `bench/results/{results}`). CPU µs per 1/60 s step over {steps} steps, the median of "
-         f"{meta.get('repeats', '?')} repeats in each run; below, the medians over the runs, and for the ratio "
+         f"(each run's in `bench/results/{results}`). CPU µs per 1/60 s step, the median of "
+         f"{meta.get('repeats', '?')} repeats in each run{length}. Below, the medians over the runs, and for the ratio "
          "the median and range of the runs' own ratios. The plot shows the range of the runs as bars; "
          f"`python bench/report.py --replot bench/results/{results}` redraws it.", "",
          f"![libcollide against {names[peer]}: cost per body and step]({rel}/{PLOT})", "",
-         f"| blocks | libcollide µs/step | {names[peer]} µs/step | libcollide / {short} "
-         "(range) | libcollide µs per block (range) | runs |", "|---|---|---|---|---|---|"]
+         f"| blocks | steps | libcollide µs/step | {names[peer]} µs/step | libcollide / {short} "
+         f"(range) | libcollide µs per block (range) | {short} µs per block (range) | runs |",
+         "|---|---|---|---|---|---|---|---|"]
     for r in agg:
-        lc, pe, ra, pb = r[LC], r[peer], r["ratio"], r[LC + "_per_body"]
-        L.append(f"| {r['n']} | {_num(lc['median'])} | {_num(pe['median'])} | "
-                 f"{ra['median']:.2f} ({ra['lo']:.2f}-{ra['hi']:.2f}) | "
-                 f"{pb['median']:.2f} ({pb['lo']:.2f}-{pb['hi']:.2f}) | {r['ratio_runs']}/{r['runs']} |")
+        lc, pe, ra = r[LC], r[peer], r["ratio"]
+        pb, qb = r[LC + "_per_body"], r[peer + "_per_body"]
+        L.append(f"| {r['n']} | {', '.join(f'{a} × {b}' for a, b in r['laps']) or '—'} | {_num(lc['median'])} | "
+                 f"{_num(pe['median'])} | {ra['median']:.2f} ({ra['lo']:.2f}-{ra['hi']:.2f}) | "
+                 f"{pb['median']:.2f} ({pb['lo']:.2f}-{pb['hi']:.2f}) | "
+                 f"{qb['median']:.2f} ({qb['lo']:.2f}-{qb['hi']:.2f}) | {r['ratio_runs']}/{r['runs']} |")
     sp, at_lo, at_hi = spread(agg)
+    psp, p_lo, p_hi = spread(agg, peer)
     top = [r for r in agg if r["n"] >= 5000]
     L += ["", f"libcollide's median cost per block is highest at {_num(at_hi)} blocks and lowest at {_num(at_lo)}: "
-          f"{sp:.2f}x apart ({'within' if sp <= WINDOW else 'outside'} the {WINDOW:g}x window)."
-          + "".join(f" At {_num(r['n'])} blocks it costs {r['ratio']['median']:.2f}x {short} (median ratio)."
+          f"{sp:.2f}x apart ({'within' if sp <= WINDOW else 'outside'} the {WINDOW:g}x window); "
+          f"{short}'s is highest at {_num(p_hi)} and lowest at {_num(p_lo)}: {psp:.2f}x apart."
+          + "".join(f" At {_num(r['n'])} blocks libcollide costs {r['ratio']['median']:.2f}x {short} (median ratio)."
                     for r in top),
           END]
     return L
