@@ -30,8 +30,12 @@ class Task:
     key: str = ""                     # case key (scene + setting) for grouping
     stream: bool = False              # send every sample to the parent as it is taken, so that a run
                                       # killed inside a step still returns the states it reached
+    laps: int = 1                     # the scene this many times from a fresh build, CPU and steps summed
+                                      # (a short scene long enough to time); states and stages of the last
 
     def __post_init__(self) -> None:
+        if self.laps < 1 or (self.laps > 1 and self.stream):
+            raise ValueError(f"laps = {self.laps}: at least 1, and 1 for a streamed task")
         if not self.label:
             self.label = self.engine
         if not self.key:
@@ -42,42 +46,47 @@ def run_task(task: Task, progress: Any = None) -> dict[str, Any]:
     """Executed in the worker: build, step, sample. Returns plain data; progress(steps, cpu) after
     every chunk lets the parent tell a slow step from a dead worker."""
     import engines
-    t_build = time.thread_time()
-    eng = engines.make(task.engine, task.scene, task.settings)
-    build = time.thread_time() - t_build
     total = int(round(task.scene.duration / task.dt))
     # chunks of at most 0.25 s simulated, so the CPU budget is checked often
     per = max(1, int(round((0.25 if task.sample_dt is None else task.sample_dt) / task.dt)))
-    times, states = [0.0], [eng.states()]
-    if progress is not None and task.stream:
-        progress(0, 0.0, states[0])
-    cpu, done, status = 0.0, 0, "ok"
-    while done < total:
-        n = min(per, total - done)
-        cpu += eng.advance(task.dt, n)
-        done += n
-        s = eng.states()
+    cpu, done, build, status = 0.0, 0, 0.0, "ok"
+    for _ in range(task.laps):
+        t_build = time.thread_time()
+        eng = engines.make(task.engine, task.scene, task.settings)
+        build += time.thread_time() - t_build
+        times, states = [0.0], [eng.states()]
         if progress is not None and task.stream:
-            progress(done, cpu, s)
-        elif progress is not None:
-            progress(done, cpu)
-        if task.sample_dt is None and len(states) > 1:
-            times.pop()
-            states.pop()   # start and end only
-        times.append(done * task.dt)
-        states.append(s)
-        if getattr(eng, "status", 0):
-            status = f"step error status {eng.status}"
-            break
-        if not np.all(np.isfinite(s)):
-            status = "nan"
-            break
-        if cpu > task.budget and done < total:
-            status = "over_budget"
+            progress(0, 0.0, states[0])
+        lap = 0
+        while lap < total:
+            n = min(per, total - lap)
+            cpu += eng.advance(task.dt, n)
+            lap += n
+            done += n
+            s = eng.states()
+            if progress is not None and task.stream:
+                progress(done, cpu, s)
+            elif progress is not None:
+                progress(done, cpu)
+            if task.sample_dt is None and len(states) > 1:
+                times.pop()
+                states.pop()   # start and end only
+            times.append(lap * task.dt)
+            states.append(s)
+            if getattr(eng, "status", 0):
+                status = f"step error status {eng.status}"
+                break
+            if not np.all(np.isfinite(s)):
+                status = "nan"
+                break
+            if cpu > task.budget and done < total * task.laps:
+                status = "over_budget"
+                break
+        if status != "ok":
             break
     return {"key": task.key, "engine": task.engine, "label": task.label, "scene": task.scene.name,
             "dt": task.dt, "settings": task.settings, "steps": done, "sim_time": done * task.dt,
-            "cpu": cpu, "build_cpu": build, "status": status, "times": np.array(times),
+            "laps": task.laps, "cpu": cpu, "build_cpu": build, "status": status, "times": np.array(times),
             "states": np.array(states), "stages": eng.stages(), "precision": eng.precision}
 
 

@@ -4,12 +4,15 @@ error on the seed and hard-case scenes (docs/benchmarks.md). Use bench/run (it i
     bench/run [--quick | --full] [--sections wp,ref,impacts,cradle,tunnel,stacks,hard,pyramid,scaling]
     bench/run [--quick] --sections contact [--seeds 1,2,3]   # piles, pushing, friction (bench/contact.py)
     bench/run [--quick] --sections contact_wp   # the peers' accuracy knobs on those scenes (bench/contact_wp.py)
+    bench/run --scaling-runs 5 --scaling-n 100,1000,2000,5000,20000 --engines box2d3   # bench/scaling_runs.py
 
 Writes docs/benchmarks.md, docs/img/bench_*.png and bench/results/latest.json (and the results behind each
 page it writes: bench/results/benchmarks.json, bench_contact.json, bench_contact_wp.json). The contact section is
 not in the default list; it writes docs/bench_contact.md, and docs/benchmarks.md only when other
 sections ran too (a run of it alone leaves that page as it is). contact_wp writes its own section of
-docs/bench_contact.md and docs/img/bench_contact_wp.png."""
+docs/bench_contact.md and docs/img/bench_contact_wp.png. --scaling-runs K runs the scaling section
+alone K times and rewrites only its own block of docs/benchmarks.md (bench/results/scaling_runs.json
+keeps its data; a full report writes the block from there)."""
 from __future__ import annotations
 
 import argparse
@@ -19,7 +22,7 @@ import os
 import platform
 import sys
 import time
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 
@@ -33,6 +36,7 @@ import metrics  # noqa: E402
 import report  # noqa: E402
 import report_contact  # noqa: E402
 import report_contact_wp  # noqa: E402
+import scaling_runs  # noqa: E402
 import scenes  # noqa: E402
 from harness import Task  # noqa: E402
 
@@ -337,12 +341,22 @@ class Bench:
             ns += [5000]
         if self.args.scaling_n:
             ns = [int(x) for x in self.args.scaling_n.split(",")]
+        self.out["scaling"] = self.scaling_rows(ns, self.scaling_engines())
+
+    def scaling_engines(self) -> tuple[str, ...]:
+        return ALL if not self.args.engines else \
+            ("libcollide",) + tuple(e for e in PEERS if e in self.args.engines.split(","))
+
+    def scaling_rows(self, ns: list[int], engs: tuple[str, ...],
+                     laps_for: Callable[[int], int] | None = None) -> list[dict[str, Any]]:
+        """One run of the scaling section: a row per engine and body count (n = 0 included); laps_for(n),
+        when given, is how many times a timed repeat runs the n-body scene (Task.laps, the same for
+        every engine)."""
         # n = 0: one static box only, i.e. the per-step floor of each engine and its Python binding
         empty = scenes.Scene("many0", (scenes.Box(1.0, 1.0, 0.0, 0.0, static=True),), duration=10.0)
-        engs = ALL if not self.args.engines else \
-            ("libcollide",) + tuple(e for e in PEERS if e in self.args.engines.split(","))
         tasks = [Task(eng, empty, 1 / 60, {}, None, self.budget) for eng in engs]
-        tasks += [Task(eng, scenes.many(n), 1 / 60, {}, None, self.budget) for n in ns for eng in engs]
+        tasks += [Task(eng, scenes.many(n), 1 / 60, {}, None, self.budget, laps=laps_for(n) if laps_for else 1)
+                  for n in ns for eng in engs]
         log(f"scaling: {len(tasks)} runs")
         res = self.run(tasks)
         rows = []
@@ -352,7 +366,28 @@ class Bench:
             if n and r.get("status") == "ok" and metrics.finite(r):
                 m = metrics.seed_metrics(scenes.many(n), r)
             rows.append({**strip(r), **m, "n": n})
-        self.out["scaling"] = rows
+        return rows
+
+    def scaling_runs(self, k: int, command: str) -> None:
+        """The scaling section k times, libcollide against the one peer of --engines, each run with
+        fresh workers; its own results (out["scaling_runs"]), not the page's scaling section."""
+        engs = self.scaling_engines()
+        if len(engs) != 2:
+            raise SystemExit("bench/main.py: --scaling-runs compares libcollide with one peer: "
+                             "give it --engines with one of " + ",".join(PEERS))
+        ns = [int(x) for x in (self.args.scaling_n or "100,1000,2000,5000,20000").split(",")]
+        runs = []
+        for i in range(k):
+            if i:
+                self.pool.close()
+                self.pool = harness.Pool()
+            run: dict[str, Any] = {"start": _utc(), "load_before": os.getloadavg()}
+            log(f"scaling run {i + 1}/{k}")
+            run["rows"] = self.scaling_rows(ns, engs, scaling_runs.laps_for)
+            run.update(end=_utc(), load_after=os.getloadavg())
+            runs.append(run)
+        self.out["scaling_runs"] = {"peer": engs[1], "n": ns, "command": command, "runs": runs,
+                                    "body_steps": scaling_runs.BODY_STEPS}
 
     # ---- contact: piles, pushing, friction (bench/contact.py) ----------------------------------
     def contact(self) -> None:
@@ -391,29 +426,52 @@ def main() -> int:
     ap.add_argument("--scaling-n", help="comma list of body counts for the scaling section (e.g. 100,500,2000,5000,20000) "
                     "instead of its default list")
     ap.add_argument("--engines", help="comma list of engines for the scaling section (default: all; libcollide always)")
+    ap.add_argument("--scaling-runs", type=int, metavar="K", help="only the scaling section, K times, libcollide "
+                    "against the one peer of --engines (default counts 100,1000,2000,5000,20000): medians over "
+                    "the runs in its own block of the page (bench/scaling_runs.py); the rest of the page stays")
     args = ap.parse_args()
+    if args.scaling_runs is not None:
+        if args.scaling_runs < 1:
+            ap.error("--scaling-runs needs K >= 1")
+        if args.sections != ap.get_default("sections"):
+            ap.error("--scaling-runs runs the scaling section only: drop --sections")
     if args.seeds:
         args.seeds = contact.parse_seeds(args.seeds)   # a bad list stops here, not after the sections before contact
     t0 = time.time()
     b = Bench(args)
     import importlib.metadata as md
-    b.out["meta"] = {"date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()), "mode":
+    b.out["meta"] = {"date": _utc(), "mode":
                      "quick" if args.quick else ("full" if args.full else "default"),
                      "repeats": b.repeats, "budget_cpu_s": b.budget, "machine": platform.machine(),
                      "cpus": os.cpu_count(), "python": platform.python_version(),
                      "cpu_model": _cpu_model(), "load_before": os.getloadavg(), "libcollide": _lc_build(),
                      "versions": {p: _ver(md, p) for p in ("pymunk", "pyb2d3", "Box2D", "numpy", "matplotlib")}}
     try:
-        for sec in args.sections.split(","):
-            getattr(b, sec.strip())()
+        if args.scaling_runs is not None:
+            b.scaling_runs(args.scaling_runs, " ".join(["bench/run"] + sys.argv[1:]))
+        else:
+            for sec in args.sections.split(","):
+                getattr(b, sec.strip())()
     finally:
         b.pool.close()
     b.out["meta"]["wall_s"] = time.time() - t0
     b.out["meta"]["load_after"] = os.getloadavg()
     save_results(b.out, "latest.json")
-    if not args.no_report:
+    if "scaling_runs" in b.out:
+        b.out["scaling_runs"]["meta"] = b.out["meta"]
+        if not args.no_report:
+            docs = os.path.dirname(os.path.abspath(args.out))
+            scaling_runs.write_block(b.out["scaling_runs"], args.out, os.path.join(docs, "img"), report.NAMES,
+                                     report.COLORS)
+            log(f"wrote the scaling-runs block of {args.out} and img/{scaling_runs.PLOT}")
+            save_results(b.out, scaling_runs.results_name(args.out))
+    elif not args.no_report:
         docs = os.path.dirname(os.path.abspath(args.out))
         if any(sec.strip() not in ("contact", "contact_wp") for sec in args.sections.split(",")):
+            # the page keeps the block of the last --scaling-runs run (its own date, commit and load)
+            stored = stored_scaling_runs(args.out)
+            if stored:
+                b.out["scaling_runs"] = stored
             report.write(b.out, args.out, os.path.join(docs, "img"))
             log(f"wrote {args.out}")
             # the data behind this page's figures, kept until the page is written again
@@ -441,6 +499,19 @@ def save_results(out: dict[str, Any], name: str) -> None:
     with open(path, "w") as f:
         json.dump(out, f, indent=1, default=_json)
     log(f"wrote {path}")
+
+
+def stored_scaling_runs(page: str) -> dict[str, Any] | None:
+    """The comparison of the last bench/run --scaling-runs that wrote the page, if it is stored."""
+    path = os.path.join(HERE, "results", scaling_runs.results_name(page))
+    if not os.path.exists(path):
+        return None
+    with open(path) as fh:
+        return json.load(fh).get("scaling_runs")
+
+
+def _utc() -> str:
+    return time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime())
 
 
 def _lc_build() -> str:

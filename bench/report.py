@@ -2,6 +2,7 @@
 section's page, docs/bench_contact.md: report_contact.py).
 
     python bench/report.py --replot [bench/results/benchmarks.json]   # redraw the page's figures only
+    python bench/report.py --replot bench/results/scaling_runs.json   # the plot of bench/run --scaling-runs
 """
 from __future__ import annotations
 
@@ -14,6 +15,9 @@ import tempfile
 from typing import Any
 
 import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import scaling_runs  # noqa: E402
 
 COLORS = {"libcollide": "#d62728", "pymunk": "#1f77b4", "box2d3": "#2ca02c", "box2d2": "#9467bd"}
 NAMES = {"libcollide": "libcollide", "pymunk": "Chipmunk (pymunk)", "box2d3": "Box2D v3 (pyb2d3)",
@@ -241,6 +245,8 @@ def write(out: dict[str, Any], path: str, img_dir: str) -> None:
           "bench/run --lib /path/to/build     # measure the libcollide.so of another build (first argument)",
           "bench/run --budget 60              # CPU seconds per run before it is stopped",
           "python bench/report.py --replot    # redraw this page's figures from bench/results/benchmarks.json, no new run",
+          "bench/run --scaling-runs 5 --scaling-n 100,1000,2000,5000,20000 --engines box2d3",
+          "                                   # libcollide against Box2D v3 over 5 runs: only its block of this page",
           "```", "",
           "`bench/run` installs the pinned peers of `bench/requirements.txt` into the project venv "
           "(`.venv`, made by `scripts/setup`) on first use, then runs `nice python bench/main.py`.", ""]
@@ -567,6 +573,12 @@ def write(out: dict[str, Any], path: str, img_dir: str) -> None:
             name = "0 (one static box: the per-step floor of engine + binding)" if n == 0 else str(n)
             L.append(f"| {name} | " + " | ".join(cells) + f" | {bp} | {adv} |")
         L += [""]
+    sr = out.get("scaling_runs")
+    if sr:
+        if not sc:
+            L += ["## Scaling: step cost against body count", "", "This run did not run the scaling section.", ""]
+        scaling_runs.plot(sr, os.path.join(img_dir, scaling_runs.PLOT), NAMES, COLORS)
+        L += scaling_runs.section(sr, rel, NAMES, scaling_runs.results_name(path)) + [""]
 
     if out.get("contact"):
         L += ["## Contact scenes: piles, pushing, friction", "",
@@ -666,7 +678,8 @@ def write(out: dict[str, Any], path: str, img_dir: str) -> None:
         x.startswith("## ") for x in L[idx + 1:]) else len(L)
     L = L[:end] + head + L[end:]
     L += ["## Not covered yet", "",
-          "- Pyramid base 100 and scaling beyond 2000 bodies run only in `--full` (up to 5000 bodies); "
+          "- Pyramid base 100 and scaling beyond 2000 bodies run only in `--full` (up to 5000 bodies; "
+          "`--scaling-runs` goes to 20 000 against one peer); "
           "an engine that did not finish a smaller pyramid is not run on the larger ones.",
           "- Rapier2D (needs a Rust driver) and native Box2D v3 with SIMD: not run here; "
           "their figures are in `../shared/notes/peer_bench.md`.",
@@ -705,11 +718,12 @@ def main() -> int:
         return 1
     with open(args.replot) as fh:
         out = json.load(fh)
-    if not any(k in out for k in ("wp", "ref", "scaling")):
-        print(f"report.py: {args.replot} holds no section with figures (wp, ref, scaling)", file=sys.stderr)
+    secs = ("wp", "ref", "scaling", "scaling_runs")
+    if not any(k in out for k in secs):
+        print(f"report.py: {args.replot} holds no section with figures ({', '.join(secs)})", file=sys.stderr)
         return 1
     replot(out, args.img_dir)
-    print(f"report.py: figures of {', '.join(k for k in ('wp', 'ref', 'scaling') if k in out)} "
+    print(f"report.py: figures of {', '.join(k for k in secs if k in out)} "
           f"from {out.get('meta', {}).get('date', '?')} redrawn into {args.img_dir}")
     return 0
 
