@@ -7,32 +7,18 @@ pair or under-reports a rotated one would flatter the engine that lets boxes sin
 No peer engine is needed (none is imported)."""
 from __future__ import annotations
 
-import importlib.util
 import itertools
 import math
-import sys
-from pathlib import Path
 from types import ModuleType
 
 import numpy as np
 import pytest
 
-ROOT = Path(__file__).resolve().parents[2]
-BENCH = ROOT / "bench"
+from bench_module import load_bench
 
 
-def _load(name: str) -> ModuleType:
-    """bench/<name>.py under the module name bench_<name> (registered: dataclasses need it)."""
-    spec = importlib.util.spec_from_file_location(f"bench_{name}", BENCH / f"{name}.py")
-    assert spec is not None and spec.loader is not None
-    mod = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = mod
-    spec.loader.exec_module(mod)
-    return mod
-
-
-m = _load("metrics")
-sc = _load("scenes")
+m = load_bench("metrics")
+sc = load_bench("scenes")
 
 
 def _scene(*boxes: object, gravity: float = 0.0) -> object:
@@ -205,7 +191,7 @@ def test_push_row_rests_on_the_floor_with_gaps() -> None:
 
 @pytest.fixture(scope="module")
 def contact() -> ModuleType:
-    return _load("contact")          # it imports harness, metrics and scenes by name; no engine
+    return load_bench("contact")          # it imports harness, metrics and scenes by name; no engine
 
 
 def _run(engine: str, status: str, steps: int, cpu: float, states: np.ndarray) -> dict:
@@ -234,7 +220,7 @@ def test_a_run_over_budget_keeps_its_steps_cpu_and_quality(contact: ModuleType) 
                                     "steps_done": 5, "cpu_done": 2.0, "states": states[:6]})
     assert killed["kind"] == "over budget" and killed["killed_in_step"] and math.isclose(killed["us_per_step"], 4e5)
 
-    report = _load("report_contact")
+    report = load_bench("report_contact")
     sec = {"engines": ["libcollide", "box2d3"], "rows": [lc, peer], "repeats": 1, "dt": 1 / 60,
            "settings": contact.CONTACT_SETTINGS, "budget_cpu_s": 20.0, "peer_budget_cpu_s": 600.0,
            "scenes": {"stack10": {"name": cs.scene.name, "what": cs.what, "bodies": 10, "steps": 600,
@@ -282,7 +268,7 @@ def test_random_piles_take_the_median_cost_and_the_worst_quality_over_seeds(cont
     assert agg["e_change"] == -0.5 and agg["stages"] == {"steps": 641, "collisions": 6}
     assert rows[1]["kind"] == "ok" and rows[1]["max_overlap"] == 0.0
 
-    report = _load("report_contact")
+    report = load_bench("report_contact")
     sec = {"engines": ["libcollide", "box2d3"], "rows": rows, "repeats": 1, "dt": 1 / 60,
            "settings": contact.CONTACT_SETTINGS, "budget_cpu_s": 20.0, "peer_budget_cpu_s": 600.0,
            "scenes": {"mixed30": {"name": "mixed30_s1, mixed30_s2, mixed30_s3", "what": "pile", "bodies": 30,

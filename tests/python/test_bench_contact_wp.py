@@ -5,38 +5,25 @@ that reaches libcollide's level or say that none does, and a rewrite of docs/ben
 writer must keep the section. No peer engine is needed (none is imported)."""
 from __future__ import annotations
 
-import importlib.util
 import json
 import math
-import sys
 from pathlib import Path
 from types import ModuleType
 
 import numpy as np
 import pytest
 
-ROOT = Path(__file__).resolve().parents[2]
-BENCH = ROOT / "bench"
-
-
-def _load(name: str) -> ModuleType:
-    """bench/<name>.py under the module name bench_<name> (registered: dataclasses need it)."""
-    spec = importlib.util.spec_from_file_location(f"bench_{name}", BENCH / f"{name}.py")
-    assert spec is not None and spec.loader is not None
-    mod = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = mod
-    spec.loader.exec_module(mod)
-    return mod
+from bench_module import load_bench
 
 
 @pytest.fixture(scope="module")
 def wp() -> ModuleType:
-    return _load("contact_wp")
+    return load_bench("contact_wp")
 
 
 @pytest.fixture(scope="module")
 def rep() -> ModuleType:
-    return _load("report_contact_wp")
+    return load_bench("report_contact_wp")
 
 
 class _FakePool:
@@ -116,7 +103,7 @@ def test_section_survives_both_writers(rep: ModuleType, tmp_path: Path) -> None:
     assert page.count(rep.BEGIN) == again.count(rep.BEGIN) == 1
     assert again.startswith("# Page\n\ntable\n") and again.endswith("tail\n") and "### push" not in again
     # bench/run --sections contact rewrites the whole page: the section comes back from the JSON
-    report_contact = _load("report_contact")
+    report_contact = load_bench("report_contact")
     results = tmp_path / "wp.json"
     results.write_text(json.dumps({"meta": {}, "contact_wp": SEC}))
     sec = {"engines": ["libcollide"], "rows": [], "repeats": 1, "dt": 1 / 60, "settings": {"libcollide": {}},

@@ -5,24 +5,19 @@ benchmark's trajectory-error section ranks engines by, so a measure that under-r
 engine drifts by rotation."""
 from __future__ import annotations
 
-import importlib.util
 import math
-from pathlib import Path
 from types import ModuleType
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parents[2]
+from bench_module import load_bench
+
 W, H = 1.0, 0.5                        # the seed block (bench/scenes.py)
 R = math.hypot(W, H) / 2
 
 
 def _metrics() -> ModuleType:
-    spec = importlib.util.spec_from_file_location("bench_metrics", ROOT / "bench" / "metrics.py")
-    assert spec is not None and spec.loader is not None
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
+    return load_bench("metrics")
 
 
 def _corners(state: np.ndarray) -> np.ndarray:

@@ -15,15 +15,13 @@ from typing import Any
 
 import pytest
 
+from bench_module import load_bench
+
 ROOT = Path(__file__).resolve().parents[2]
 
 
 def _mod() -> ModuleType:
-    spec = importlib.util.spec_from_file_location("bench_scaling_runs", ROOT / "bench" / "scaling_runs.py")
-    assert spec is not None and spec.loader is not None
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
+    return load_bench("scaling_runs")
 
 
 def _row(engine: str, n: int, us: float, status: str = "ok") -> dict[str, Any]:
@@ -91,7 +89,6 @@ def test_splice_replaces_only_the_block() -> None:
     assert out == f"# Page\n\nbefore\n{sr.BEGIN}\nnew table\n{sr.END}\nafter\n"
     with pytest.raises(ValueError):
         sr.splice("# Page without the block\n", [sr.BEGIN, sr.END])
-
 
 
 def test_laps_for_gives_each_repeat_the_body_steps_floor() -> None:

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import collide
-from node_bench_module import load_node_bench
+from bench_module import load_node_bench
 
 nb = load_node_bench()
 

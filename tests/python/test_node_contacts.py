@@ -12,11 +12,8 @@ must decode field by field to the object path's message and match its bytes. The
 """
 from __future__ import annotations
 
-import importlib.util
-import sys
 from collections.abc import Iterator
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -33,7 +30,8 @@ import collide
 from collide_ros import cdr
 from collide_ros.node import MAX_CONTACTS_PER_MESSAGE, SimNode, _concat_rows
 
-ROOT = Path(__file__).resolve().parents[2]
+from bench_module import load_node_bench
+
 STEPS = 2000      # the pile holds 1000 contacts per message from ~1.5 s on
 KILL_AT = 1700    # step after which a body with unread impacts is killed
 FIELDS = ("body_a", "body_b", "point", "normal", "gap", "normal_velocity", "impulse", "tangent_impulse",
@@ -41,12 +39,7 @@ FIELDS = ("body_a", "body_b", "point", "normal", "gap", "normal_velocity", "impu
 
 
 def _pile_scene(n: int) -> dict[str, Any]:
-    spec = importlib.util.spec_from_file_location("bench_node_bench", ROOT / "bench" / "node_bench.py")
-    assert spec is not None and spec.loader is not None
-    mod = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = mod
-    spec.loader.exec_module(mod)
-    return mod.pile_scene(n)
+    return load_node_bench().pile_scene(n)
 
 
 def object_path(rows: np.ndarray, name_of_id: dict[int, str], stamp: Time, frame: str) -> Contacts:

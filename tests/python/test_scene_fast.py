@@ -19,7 +19,7 @@ import collide
 from collide import SceneError, load_scene
 from collide.scene import _MAX_DEPTH, _MAX_NODES, _load_lined, _parse_text, load_scene_text, read_scene_text
 from collide.scene_fast import NotPlain, read_plain
-from node_bench_module import load_node_bench
+from bench_module import load_node_bench
 
 ROOT = Path(__file__).resolve().parents[2]
 SCENES = ROOT / "scenes"
