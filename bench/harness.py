@@ -31,7 +31,8 @@ class Task:
     stream: bool = False              # send every sample to the parent as it is taken, so that a run
                                       # killed inside a step still returns the states it reached
     laps: int = 1                     # the scene this many times from a fresh build, CPU and steps summed
-                                      # (a short scene long enough to time); states and stages of the last
+                                      # (a short scene long enough to time); states and stages are the
+                                      # last lap's
 
     def __post_init__(self) -> None:
         if self.laps < 1 or (self.laps > 1 and self.stream):
