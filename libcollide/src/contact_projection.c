@@ -100,6 +100,7 @@ int lc_contact_project(lc_contact_projection *cp, lc_contact_island *c, lc_buf *
         lc_touch *t;
         lc_contact_row *rows;
         lc_contact_solve ps;
+        lc_contact_stop stop;
         int any = 0;
         /* the points within twice the deepest overlap too: pushing a pair apart by that much can push
          * a neighbour in (a row of boxes), and a point the solve does not hold is one pass more each */
@@ -129,8 +130,8 @@ int lc_contact_project(lc_contact_projection *cp, lc_contact_island *c, lc_buf *
         }
         if (nt >= LC_CONTACT_PROJECTION_DIRECT_ROWS && start_projection(cp, c, t, nt, gp, rows) != 0) return -1;
         memset(c->b.disp, 0, (size_t)c->b.n * 3 * sizeof(double));
-        ps = lc_contact_solver_run(rows, nt, c->b.disp, c->b.inv_mass, c->b.inv_inertia, LC_CONTACT_PROJECTION_SWEEPS,
-                                   c->slack, LC_CONTACT_STALL_SWEEPS);
+        stop = lc_contact_stop_rule(LC_CONTACT_PROJECTION_SWEEPS, c->slack, LC_CONTACT_STALL_SWEEPS);
+        ps = lc_contact_solver_run(rows, nt, c->b.disp, c->b.inv_mass, c->b.inv_inertia, &stop);
         /* a pass that cut the overlap a hundredfold is kept: the next pass starts from there */
         if (ps.residual > c->slack && ps.residual > LC_CONTACT_PROJECTION_GAIN * *left) {
             memset(c->b.disp, 0, (size_t)c->b.n * 3 * sizeof(double));

@@ -17,7 +17,10 @@
  *      solved by nonsmooth Gauss-Seidel (contact_solver.c), and in a precise retry of few points exactly
  *      (contact_active_set.c, else contact_exact.c);
  *   4. in small islands, a stick-slip transition or a new contact's arrival inside the step cuts the
- *      step there, and the rest is taken again from step 1;
+ *      step there, and the rest is taken again from step 1; in a settling sub-step (a large island
+ *      moving slower than LC_CONTACT_SETTLE_SPEED, whose solves then run to convergence) an undriven
+ *      island whose answer moves no point faster than LC_CONTACT_REST_SPEED rests: its velocities
+ *      become 0;
  *   5. positions: x += h (v_0 + v) / 2 (exact under constant forces), or x += h v (Moreau-Jean) in a
  *      sub-step of several bodies and fewer than LC_CONTACT_MOREAU_JEAN_POINTS points, and in a pile
  *      sub-step;
@@ -60,6 +63,7 @@ struct lc_contact_regime {
     lc_buf b_vstart;     /* start velocities of an exact solve */
     lc_buf b_known;      /* per flow row: 1 if the last step kept a force for its point (even 0) */
     lc_buf b_margin;     /* per island pair: the margin of the last end-of-step search */
+    lc_buf b_sweep_v;    /* a settling solve's velocities before each sweep */
 };
 
 lc_contact_regime *lc_contact_regime_create(void)
@@ -100,6 +104,7 @@ void lc_contact_regime_destroy(lc_contact_regime *cr)
     lc_buf_free(&cr->b_vstart);
     lc_buf_free(&cr->b_known);
     lc_buf_free(&cr->b_margin);
+    lc_buf_free(&cr->b_sweep_v);
     free(cr);
 }
 
@@ -194,7 +199,8 @@ static void count_solve(lc_contact_island *c, lc_contact_solve s, int rows);
 
 /* Solves rows[0..m) from the velocities in b.v (their start) into b.v: Gauss-Seidel with momentum from
  * the rows' warm start (contact_solver.c), at most contact_iterations sweeps (scaled up for fewer than
- * LC_CONTACT_SMALL_POINTS points), to contact_tolerance. In a
+ * LC_CONTACT_SMALL_POINTS points), to contact_tolerance; in a settling sub-step by the settling rule
+ * (tunables.h, LC_CONTACT_SETTLE_SPEED). In a
  * precise retry (lc_contact_advance) a problem of at most LC_CONTACT_PRECISE_EXACT_POINTS points is
  * solved exactly (contact_exact.c: active sets, else Lemke) and confirmed by sweeps from that answer, a larger one by up to
  * LC_CONTACT_PRECISE_SWEEPS sweeps. Returns 0, or -1 without memory. */
@@ -204,8 +210,19 @@ static int solve(lc_contact_island *c, lc_contact_row *rows, int m)
     lc_contact_solve s;
     int sweeps = c->precise && w->def.contact_iterations < LC_CONTACT_PRECISE_SWEEPS ? LC_CONTACT_PRECISE_SWEEPS
                                                                                      : w->def.contact_iterations;
+    lc_contact_stop stop;
     if (!c->precise && m > 0 && m < LC_CONTACT_SMALL_POINTS)
         sweeps = (int)fmin((double)sweeps * LC_CONTACT_SMALL_POINTS / m, (double)LC_CONTACT_PRECISE_SWEEPS);
+    stop = lc_contact_stop_rule(sweeps, w->def.contact_tolerance, c->precise ? 0 : LC_CONTACT_STALL_SWEEPS);
+    if (c->settle) {
+        if (stop.max_sweeps < LC_CONTACT_SETTLE_SWEEPS) stop.max_sweeps = LC_CONTACT_SETTLE_SWEEPS;
+        stop.tolerance = fmax(stop.tolerance, LC_CONTACT_SETTLE_TOLERANCE);
+        stop.stall_below = LC_CONTACT_REST_SPEED;
+        stop.body_tolerance = LC_CONTACT_SETTLE_BODY_TOLERANCE;
+        stop.nbodies = c->b.n;
+        stop.before = lc_buf_get(&c->cr->b_sweep_v, (size_t)(c->b.n > 0 ? c->b.n : 1) * 3 * sizeof(double));
+        if (stop.before == NULL) return -1;
+    }
     if (c->precise && m > 0 && m <= LC_CONTACT_PRECISE_EXACT_POINTS) {
         size_t nv = (size_t)c->b.n * 3;
         size_t ns = lc_contact_exact_scratch(m), na = lc_contact_active_set_scratch(m);
@@ -223,8 +240,7 @@ static int solve(lc_contact_island *c, lc_contact_row *rows, int m)
     }
     /* a precise retry runs its sweeps out: a perturbed pyramid's solve crawls, below the stall rule's
      * halving, to an answer whose energy the island can pay, where stopping left a gain */
-    s = lc_contact_solver_run(rows, m, c->b.v, c->b.inv_mass, c->b.inv_inertia, sweeps, w->def.contact_tolerance,
-                              c->precise ? 0 : LC_CONTACT_STALL_SWEEPS);
+    s = lc_contact_solver_run(rows, m, c->b.v, c->b.inv_mass, c->b.inv_inertia, &stop);
     count_solve(c, s, m);
     return 0;
 }
@@ -506,6 +522,39 @@ static int island_driven(const lc_contact_island *c)
     return 0;
 }
 
+/* Whether a sub-step starting from b.v0 settles (LC_CONTACT_SETTLE_SPEED): the island is large enough
+ * and its mass-weighted rms speed is below the speed. A precise retry keeps its own solves. */
+static int settling(const lc_contact_island *c)
+{
+    double mass = 0.0, mv2 = 0.0;
+    int k;
+    if (c->precise || c->isl->nrows < LC_CONTACT_SETTLE_BODIES) return 0;
+    for (k = 0; k < c->b.n; ++k) {
+        const double *v = &c->b.v0[k * 3];
+        double m;
+        if (!(c->b.inv_mass[k] > 0.0)) continue;
+        m = 1.0 / c->b.inv_mass[k];
+        mass += m;
+        mv2 += m * (v[0] * v[0] + v[1] * v[1]);
+    }
+    return mass > 0.0 && mv2 < LC_CONTACT_SETTLE_SPEED * LC_CONTACT_SETTLE_SPEED * mass;
+}
+
+/* Rest (LC_CONTACT_REST_SPEED): after a settling sub-step's solves, an undriven island none of whose
+ * bodies' points moves faster than the rest speed keeps still: b.v becomes 0. */
+static void hold_at_rest(lc_contact_island *c)
+{
+    const lc_world *w = c->w;
+    int k;
+    for (k = 0; k < c->b.n; ++k) {
+        const double *v = &c->b.v[k * 3];
+        if (hypot(v[0], v[1]) + fabs(v[2]) * w->shape[c->isl->rows[k]].radius >= LC_CONTACT_REST_SPEED) return;
+    }
+    if (island_driven(c)) return;
+    memset(c->b.v, 0, (size_t)c->b.n * 3 * sizeof(double));
+    c->w->last.contact_rests++;
+}
+
 /* Step 6b: an island no force but gravity and contacts drives ends with at most the energy it began
  * with (the flow and the impacts dissipate; the projection's lift and the rotation's nonlinearity may
  * not); an excess is taken from the kinetic energy by scaling the velocities. Returns the part the
@@ -615,6 +664,7 @@ static int advance(lc_contact_island *c, double dt, double e0, double size0, int
         c->slack = c->pile || isl->nrows >= LC_CONTACT_LARGE_ISLAND_BODIES ? LC_CONTACT_PROJECTION_LARGE_SLACK
                                                                             : LC_CONTACT_PROJECTION_SLACK;
         for (i = 0; i < isl->nrows; ++i) memcpy(&c->b.v0[i * 3], &w->state[isl->rows[i] * 6 + 3], 3 * sizeof(double));
+        c->settle = settling(c);
         if (impacts(c, t, *nt, h) < 0 || flow(c, t, *nt, h, rows) != 0) return -1;
         if (c->pile && record_pile_impacts(c, t, rows, *nt, h) != 0) return -1;
         tau = c->small && cuts < LC_CONTACT_MAX_CUTS ? first_transition(c, t, rows, *nt, h) : 1.0;
@@ -625,6 +675,7 @@ static int advance(lc_contact_island *c, double dt, double e0, double size0, int
             cuts++;
             w->last.contact_cuts++;
         }
+        if (c->settle) hold_at_rest(c);
         advance_positions(c, h);
         left = h < left ? left - h : 0.0;
         if (left < 1e-14 * dt) left = 0.0;

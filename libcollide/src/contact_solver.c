@@ -1,6 +1,7 @@
 /* Nonsmooth Gauss-Seidel on contact impulses (see contact_solver.h for the problem and the stopping
  * rule). */
 #include <math.h>
+#include <string.h>
 #include "contact_solver.h"
 
 static double row_mass(const lc_contact_row *r, double rla, double rlb, const double *inv_mass,
@@ -218,9 +219,30 @@ static double sweep(lc_contact_row *rows, int nrows, double *v, const double *in
     return change;
 }
 
+lc_contact_stop lc_contact_stop_rule(int max_sweeps, double tolerance, int stall_sweeps)
+{
+    lc_contact_stop stop;
+    stop.max_sweeps = max_sweeps;
+    stop.tolerance = tolerance;
+    stop.stall_sweeps = stall_sweeps;
+    stop.stall_below = INFINITY;
+    stop.body_tolerance = 0.0;
+    stop.nbodies = 0;
+    stop.before = NULL;
+    return stop;
+}
+
+/* Whether the last sweep changed no velocity component by more than the stop's body_tolerance. */
+static int bodies_still(const lc_contact_stop *stop, const double *v)
+{
+    int i;
+    for (i = 0; i < stop->nbodies * 3; ++i)
+        if (!(fabs(v[i] - stop->before[i]) <= stop->body_tolerance)) return 0;
+    return 1;
+}
+
 lc_contact_solve lc_contact_solver_run(lc_contact_row *rows, int nrows, double *v, const double *inv_mass,
-                                       const double *inv_inertia, int max_sweeps, double tolerance,
-                                       int stall_sweeps)
+                                       const double *inv_inertia, const lc_contact_stop *stop)
 {
     lc_contact_solve out;
     double checkpoint = INFINITY, rr_old = 0.0;
@@ -247,19 +269,20 @@ lc_contact_solve lc_contact_solver_run(lc_contact_row *rows, int nrows, double *
         prepare_block(&rows[i], inv_mass, inv_inertia);
         if (rows[i].block) ++i;
     }
-    for (s = 0; s < max_sweeps; ++s) {
+    for (s = 0; s < stop->max_sweeps; ++s) {
         double change, rr = 0.0, beta;
-        if (stall_sweeps > 0 && s > 0 && s % stall_sweeps == 0) {
+        if (stop->stall_sweeps > 0 && s > 0 && s % stop->stall_sweeps == 0) {
             /* Gauss-Seidel on frictional rows can crawl at a ratio near 1 (two bodies whose points'
              * friction and normal impulses trade through their rotation): a solve whose largest
              * change has not halved in that many sweeps stops and reports it */
-            if (!(out.residual < 0.5 * checkpoint)) break;
+            if (!(out.residual < 0.5 * checkpoint) && out.residual < stop->stall_below) break;
             checkpoint = out.residual;
         }
+        if (stop->body_tolerance > 0.0) memcpy(stop->before, v, (size_t)stop->nbodies * 3 * sizeof(double));
         change = sweep(rows, nrows, v, inv_mass, inv_inertia, &rr);
         out.sweeps = s + 1;
         out.residual = change;
-        if (change <= tolerance) break;
+        if (change <= stop->tolerance || (stop->body_tolerance > 0.0 && bodies_still(stop, v))) break;
         /* Nonsmooth nonlinear conjugate gradients (Silcowitz, Niebe and Erleben 2010): the sweep's
          * step r = lambda - lambda_prev is a descent direction; adding beta times the last direction,
          * beta = |r|^2 / |r_old|^2 (Fletcher-Reeves, restarted when it exceeds 1), carries a stack's

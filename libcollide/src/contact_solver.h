@@ -19,11 +19,14 @@
  * Velocities are updated after every point (its normal row and its friction row read the velocities
  * once and write them once, the friction row's tangent velocity updated through A's coupling), so a
  * sweep costs O(rows).
- * Stopping rule: a sweep whose largest change of any row, in velocity units (|d lambda| times the
- * row's inverse effective mass, m/s), is at most `tolerance` ends the solve: every row then met its
- * condition to `tolerance` when it was visited. Otherwise the solve ends after `max_sweeps` sweeps,
- * or when that largest change has not halved over `stall_sweeps` sweeps (the iteration crawls; 0:
- * never), and reports it as its residual. A warm start (the impulses passed in) is applied
+ * Stopping rule (lc_contact_stop): a sweep whose largest change of any row, in velocity units
+ * (|d lambda| times the row's inverse effective mass, m/s), is at most `tolerance` ends the solve:
+ * every row then met its condition to `tolerance` when it was visited. With `body_tolerance`, so does
+ * a sweep that changed no body's velocity component by more than it (a pile's impulses are not unique,
+ * and Gauss-Seidel can trade them between rows sweep after sweep at velocities that no longer move).
+ * Otherwise the solve ends after `max_sweeps` sweeps, or when that largest change, below
+ * `stall_below`, has not halved over `stall_sweeps` sweeps (the iteration crawls; 0: never), and
+ * reports it as its residual. A warm start (the impulses passed in) is applied
  * to the velocities first; a quiescent, well warm-started problem ends after one sweep. */
 #ifndef LC_CONTACT_SOLVER_H
 #define LC_CONTACT_SOLVER_H
@@ -51,6 +54,20 @@ typedef struct lc_contact_row {
     double dir_n, dir_t;
 } lc_contact_row;
 
+/* When a solve stops (the stopping rule above). */
+typedef struct lc_contact_stop {
+    int max_sweeps;
+    double tolerance;      /* m/s */
+    int stall_sweeps;      /* 0: no stall rule */
+    double stall_below;    /* m/s, the largest change below which the stall rule applies (INFINITY: always) */
+    double body_tolerance; /* m/s, 0: off; else `before` holds nbodies x 3 doubles of scratch */
+    int nbodies;
+    double *before;
+} lc_contact_stop;
+
+/* The rule of max_sweeps, tolerance and stall_sweeps alone. */
+lc_contact_stop lc_contact_stop_rule(int max_sweeps, double tolerance, int stall_sweeps);
+
 typedef struct lc_contact_solve {
     int sweeps;            /* sweeps done */
     double residual;       /* m/s, the last sweep's largest change (see the stopping rule) */
@@ -59,8 +76,7 @@ typedef struct lc_contact_solve {
 /* Solves the rows in place. v: nbodies x 3 velocities (changed in place: the answer's velocities);
  * inv_mass, inv_inertia: nbodies each. Rows with a non-finite warm start start from 0. */
 lc_contact_solve lc_contact_solver_run(lc_contact_row *rows, int nrows, double *v, const double *inv_mass,
-                                       const double *inv_inertia, int max_sweeps, double tolerance,
-                                       int stall_sweeps);
+                                       const double *inv_inertia, const lc_contact_stop *stop);
 
 /* Adds the impulse dn along the row's normal and dt along its tangent to its two bodies' velocities v. */
 void lc_contact_row_apply(const lc_contact_row *r, double dn, double dt, double *v, const double *inv_mass,

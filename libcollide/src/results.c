@@ -70,6 +70,7 @@ void lc_counters_add(lc_counters *total, const lc_counters *last)
     total->contact_cuts += last->contact_cuts;
     total->contact_precise_retries += last->contact_precise_retries;
     total->energy_clamps += last->energy_clamps;
+    total->contact_rests += last->contact_rests;
     total->contact_unresolved += last->contact_unresolved;
     if (last->max_unresolved_overlap > total->max_unresolved_overlap) total->max_unresolved_overlap = last->max_unresolved_overlap;
     if (last->max_unresolved_energy > total->max_unresolved_energy) total->max_unresolved_energy = last->max_unresolved_energy;

@@ -162,6 +162,44 @@
  * to 5e-3 m/s off), the step is taken again with solves of up to this many sweeps and exact ones up to
  * this many points (a 16-point problem: ~40 pivots, where the sweeps need 100-700). */
 #define LC_CONTACT_PRECISE_SWEEPS 1000
+/* A sub-step of an island of at least LC_CONTACT_SETTLE_BODIES bodies whose mass-weighted rms speed is
+ * below LC_CONTACT_SETTLE_SPEED (m/s) when it begins is a settling sub-step. Its solves run up to
+ * LC_CONTACT_SETTLE_SWEEPS sweeps, to LC_CONTACT_SETTLE_TOLERANCE (m/s, or contact_tolerance if larger),
+ * or until a sweep changes no body's velocity component by more than LC_CONTACT_SETTLE_BODY_TOLERANCE
+ * (m/s); the stall rule applies only below LC_CONTACT_REST_SPEED (contact_solver.h, lc_contact_stop).
+ * A pile's solve stopped by the stall rule or at contact_iterations is 1e-2 to 1e-1 m/s off; that error
+ * drives its bodies into each other every step, the projection pushes them apart, and such a pile never
+ * came to rest (100 mixed boxes: the median box still moved 1-5 mm a second after 8 s). Converged, six
+ * of seven such piles rest by 4-9 s and a resting one takes one or two sweeps a step
+ * (bench/repro/pile_rest.py). Above the speed, a falling pile's solves keep their cheap cut-off: what they
+ * leave is small beside its motion. The body rule: a pile's impulses are not unique, and Gauss-Seidel
+ * trades them between rows sweep after sweep (its largest change stays at 1e-5 m/s in a resting
+ * 1 000-box pile) at velocities that no longer move. */
+#define LC_CONTACT_SETTLE_BODIES 16
+#ifndef LC_CONTACT_SETTLE_SPEED   /* -D to measure */
+#define LC_CONTACT_SETTLE_SPEED 1e-2
+#endif
+#ifndef LC_CONTACT_SETTLE_SWEEPS   /* -D to measure */
+#define LC_CONTACT_SETTLE_SWEEPS 1000
+#endif
+#ifndef LC_CONTACT_SETTLE_TOLERANCE   /* -D to measure */
+#define LC_CONTACT_SETTLE_TOLERANCE 1e-6
+#endif
+#ifndef LC_CONTACT_SETTLE_BODY_TOLERANCE   /* -D to measure */
+#define LC_CONTACT_SETTLE_BODY_TOLERANCE 1e-7
+#endif
+/* m/s: a settling sub-step of an island that nothing but gravity and contacts drives, whose answer moves
+ * no body's point (centre speed plus |omega| times its radius) faster than this, is rest: the velocities
+ * are set to 0 before the positions move. Below this the answer is the solve's own error; moved by it,
+ * a resting pyramid sank ~2e-8 m a step until its projection lifted it back in one step, with more
+ * potential energy than its kinetic energy could pay (a box dropped on a base-15 pyramid kept 2e-5 J,
+ * 3e-9 of the world's energy, in such a step). Rest only removes kinetic energy. It holds still a body
+ * that its resting pile would start with less than this speed in a step (an acceleration below
+ * 6e-4 m/s^2 at dt 1/60, a frictionless slope under 6e-5 rad); a driven island (thruster, external
+ * force, spring, force callback) is never held. */
+#ifndef LC_CONTACT_REST_SPEED   /* -D to measure */
+#define LC_CONTACT_REST_SPEED 1e-5
+#endif
 /* Pivots the exact solver may take per unknown before it gives up (Lemke's pivoting cycles only on
  * degenerate ties, which the lexicographic rule breaks; the cap is a guard). */
 #define LC_LEMKE_PIVOTS_PER_UNKNOWN 20
