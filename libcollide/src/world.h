@@ -58,14 +58,21 @@ typedef struct lc_buf {  /* growable scratch array */
     size_t cap;          /* bytes */
 } lc_buf;
 
-/* The last two angles a body was seen at and their cosine and sine (see lc_body_trig), and the last
- * two poses (x, y, angle) and their bounding boxes (broad_phase.c). */
+/* One angle a body was seen at: its cosine and sine, and the box about the centre of mass of the
+ * body's vertices turned by it (min x, min y, max x, max y; NaN until the broad phase asks for it:
+ * broad_phase.c). Seven doubles and a pad: an entry fills one cache line. */
+typedef struct lc_trig_entry {
+    double angle, c, s, ext[4];
+    double pad;
+} lc_trig_entry;
+
+/* The last two angles a body was seen at, the newer first (lc_body_trig_entry). w->trig's rows start
+ * on a cache line (LC_TRIG_ALIGN, body.c), so a lookup that finds the newer angle reads one line: a
+ * step looks up every body several times, and 20 000 bodies' caches do not fit a 2 MiB cache. */
 typedef struct lc_trig {
-    double angle[2], c[2], s[2];
-    int next;
-    double pose[2][3], box[2][4];
-    int box_next;
+    lc_trig_entry e[2];
 } lc_trig;
+#define LC_TRIG_ALIGN 64
 
 struct lc_world {
     lc_world_def def;
@@ -85,6 +92,7 @@ struct lc_world {
     double *ext_torque;
     lc_shape *shape;
     lc_trig *trig;           /* per body; a cache, so written through even a const lc_world * */
+    void *trig_block;        /* the allocation trig lies in (trig starts on a cache line in it) */
     lc_thruster (*thrusters)[LC_MAX_THRUSTERS];
     int *thruster_count;
     uint8_t *rests_dissipative; /* touched a pair with e < 1 at the end of the last step (regime.c) */
@@ -457,24 +465,32 @@ static inline void lc_stage_end(const lc_world *w, double *field, double t0)
     if (w->stage_timing) *field += lc_stage_clock() - t0;
 }
 
-/* Cosine and sine of body `row` at `angle`. A step asks for the same few states' trig many times
- * (broad phase, crossings, separation, touches: it was 40 % of the seed scene's time), so the last
- * two angles per body are remembered; a match is bit-for-bit, so results do not change. */
-static inline void lc_body_trig(const lc_world *w, int row, double angle, double *c, double *s)
+/* Empties a body's trig cache (NaN matches no angle). */
+static inline void lc_trig_clear(lc_trig *t) { t->e[0].angle = t->e[1].angle = NAN; }
+
+/* The trig cache's entry of body `row` at `angle`, made (cosine and sine; no box yet) when neither of
+ * the last two angles is it. A step asks for the same few states' trig many times (broad phase,
+ * crossings, separation, touches: it was 40 % of the seed scene's time), so the last two angles per
+ * body are remembered; a match is bit-for-bit, so results do not change. */
+static inline lc_trig_entry *lc_body_trig_entry(const lc_world *w, int row, double angle)
 {
     lc_trig *t = &w->trig[row];
-    int k;
-    for (k = 0; k < 2; ++k)
-        if (memcmp(&t->angle[k], &angle, sizeof angle) == 0) {
-            *c = t->c[k];
-            *s = t->s[k];
-            return;
-        }
-    k = t->next;
-    t->next = 1 - k;
-    t->angle[k] = angle;
-    t->c[k] = *c = cos(angle);
-    t->s[k] = *s = sin(angle);
+    if (memcmp(&t->e[0].angle, &angle, sizeof angle) == 0) return &t->e[0];
+    if (memcmp(&t->e[1].angle, &angle, sizeof angle) == 0) return &t->e[1];
+    t->e[1] = t->e[0];
+    t->e[0].angle = angle;
+    t->e[0].c = cos(angle);
+    t->e[0].s = sin(angle);
+    t->e[0].ext[0] = NAN;
+    return &t->e[0];
+}
+
+/* Cosine and sine of body `row` at `angle` (the trig cache). */
+static inline void lc_body_trig(const lc_world *w, int row, double angle, double *c, double *s)
+{
+    const lc_trig_entry *e = lc_body_trig_entry(w, row, angle);
+    *c = e->c;
+    *s = e->s;
 }
 
 #endif
