@@ -24,6 +24,7 @@ typedef struct lc_thruster {
  * tests) then touched a new page per body; 20 000 bodies in free flight took ~30 % longer per step. */
 typedef struct lc_shape {
     int count;
+    int block_skip;                       /* bytes from the kept block's allocation to v (lc_shape_keep) */
     lc_vec2 *v;                           /* count vertices, counter-clockwise */
     lc_vec2 *n;                           /* outward unit normal of edge v[i] -> v[i+1] (same block as v) */
     lc_vec2 center_offset;                /* local-frame origin -> centre of mass, body frame */
@@ -203,7 +204,10 @@ void lc_remove_springs_of(lc_world *w, lc_body_id id);
 lc_status lc_shape_build(lc_shape *out, lc_vec2 *store, const lc_vec2 *v, int count, const lc_vec2 *center, char *why,
                          size_t why_len);
 /* Gives a shape a block of its own for count vertices and normals, copying those v and n point to when
- * they are set (a built shape's store); 0, or -1 without memory (the shape unchanged). */
+ * they are set (a built shape's store); 0, or -1 without memory (the shape unchanged). The block starts
+ * on a cache line (LC_SHAPE_ALIGN): a box's four vertices are then one line, which the broad phase reads
+ * for each body at each new angle. */
+#define LC_SHAPE_ALIGN 64
 int lc_shape_keep(lc_shape *s, int count);
 /* Frees a kept shape's block. */
 void lc_shape_release(lc_shape *s);
