@@ -231,7 +231,7 @@ static void bound_box(const lc_world *w, const double *s0, const double *s1, int
     const double *p = &s0[i * 6], *q = (s1 != s0 && !w->is_static[i]) ? &s1[i * 6] : p;
     double x0 = p[SX] < q[SX] ? p[SX] : q[SX], x1 = p[SX] < q[SX] ? q[SX] : p[SX];
     double y0 = p[SY] < q[SY] ? p[SY] : q[SY], y1 = p[SY] < q[SY] ? q[SY] : p[SY];
-    double r = w->shape[i].radius + margin;
+    double r = w->radius[i] + margin;
     r += 1e-9 * (r + fabs(x0) + fabs(x1) + fabs(y0) + fabs(y1));
     out->x0 = x0 - r;
     out->x1 = x1 + r;

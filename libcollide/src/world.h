@@ -92,6 +92,8 @@ struct lc_world {
     lc_vec2 *ext_force;
     double *ext_torque;
     lc_shape *shape;
+    double *radius;          /* shape[row].radius again, by row: the whole-world passes that need only it
+                                (broad_phase.c's bound boxes) read a double per body, not a shape row */
     lc_trig *trig;           /* per body; a cache, so written through even a const lc_world * */
     void *trig_block;        /* the allocation trig lies in (trig starts on a cache line in it) */
     lc_thruster (*thrusters)[LC_MAX_THRUSTERS];
