@@ -64,12 +64,12 @@ void lc_broad_phase_state_destroy(lc_broad_phase_state *bp)
 
 /* The box about the centre of mass of the body's vertices turned as the entry's angle says, into
  * the entry. */
-static void shape_extent(const lc_shape *sh, lc_trig_entry *e)
+static void shape_extent(const lc_outline *o, lc_trig_entry *e)
 {
     double x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY;
     int i;
-    for (i = 0; i < sh->count; ++i) {
-        lc_vec2 p = lc_rot(e->c, e->s, sh->v[i]);
+    for (i = 0; i < o->count; ++i) {
+        lc_vec2 p = lc_rot(e->c, e->s, o->v[i]);
         if (p.x < x0) x0 = p.x;
         if (p.x > x1) x1 = p.x;
         if (p.y < y0) y0 = p.y;
@@ -89,7 +89,7 @@ static void body_box(const lc_world *w, const double *s, int row, box *b)
 {
     const double *st = &s[row * 6];
     lc_trig_entry *e = lc_body_trig_entry(w, row, st[SA]);
-    if (isnan(e->ext[0])) shape_extent(&w->shape[row], e);
+    if (isnan(e->ext[0])) shape_extent(&w->outline[row], e);
     b->x0 = st[SX] + e->ext[0];
     b->y0 = st[SY] + e->ext[1];
     b->x1 = st[SX] + e->ext[2];

@@ -310,6 +310,8 @@ static int get_body(lc_reader *in, lc_world *w, int i)
     s->center_offset.y = lc_get_finite(in, "a centre of mass offset");
     s->radius = get_in(in, 0.0, INFINITY, "a polygon's radius");
     w->radius[i] = s->radius;
+    w->outline[i].v = s->v;
+    w->outline[i].count = s->count;
     s->min_edge = get_in(in, 0.0, INFINITY, "a polygon's shortest edge");
     s->area = get_in(in, 0.0, INFINITY, "a polygon's area");
     s->unit_inertia = get_in(in, 0.0, INFINITY, "a polygon's unit inertia");

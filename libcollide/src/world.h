@@ -37,6 +37,12 @@ typedef struct lc_shape {
                                              inertia's (lc_body_set_mass keeps it) */
 } lc_shape;
 
+/* A body's vertices, as its shape has them (v points into the shape's block). */
+typedef struct lc_outline {
+    const lc_vec2 *v;
+    int count;
+} lc_outline;
+
 typedef struct lc_spring_rec {
     lc_spring_id id;
     lc_spring_def def;   /* body points stored as given (local-origin frame) */
@@ -94,6 +100,8 @@ struct lc_world {
     lc_shape *shape;
     double *radius;          /* shape[row].radius again, by row: the whole-world passes that need only it
                                 (broad_phase.c's bound boxes) read a double per body, not a shape row */
+    lc_outline *outline;     /* shape[row]'s vertices again, by row, for the same reason (the boxes at each
+                                body's new angle) */
     lc_trig *trig;           /* per body; a cache, so written through even a const lc_world * */
     void *trig_block;        /* the allocation trig lies in (trig starts on a cache line in it) */
     lc_thruster (*thrusters)[LC_MAX_THRUSTERS];
