@@ -64,8 +64,8 @@ static int reserve_bodies(lc_world *w, int need)
     while (cap < need) cap *= 2;
     GROW(w->ids, cap); GROW(w->mass, cap); GROW(w->inertia, cap); GROW(w->inv_mass, cap);
     GROW(w->inv_inertia, cap); GROW(w->is_static, cap); GROW(w->elasticity, cap); GROW(w->friction, cap);
-    GROW(w->ext_force, cap); GROW(w->ext_torque, cap); GROW(w->shape, cap); GROW(w->radius, cap); GROW(w->outline, cap); GROW(w->thrusters, cap);
-    GROW(w->thruster_count, cap); GROW(w->rests_dissipative, cap);
+    GROW(w->ext_force, cap); GROW(w->ext_torque, cap); GROW(w->shape, cap); GROW(w->radius, cap);
+    GROW(w->outline, cap); GROW(w->thrusters, cap); GROW(w->thruster_count, cap); GROW(w->rests_dissipative, cap);
     GROW(w->state, (size_t)cap * LC_STATE_SIZE);
     if (!grow_trig(w, cap)) return 0;
     w->capacity = cap;
@@ -229,8 +229,8 @@ lc_status lc_world_remove_body(lc_world *w, lc_body_id id)
 #define SHIFT(arr, k) memmove(&(arr)[(size_t)row * (k)], &(arr)[(size_t)(row + 1) * (k)], (size_t)n * (k) * sizeof *(arr))
     SHIFT(w->ids, 1); SHIFT(w->mass, 1); SHIFT(w->inertia, 1); SHIFT(w->inv_mass, 1); SHIFT(w->inv_inertia, 1);
     SHIFT(w->is_static, 1); SHIFT(w->elasticity, 1); SHIFT(w->friction, 1); SHIFT(w->ext_force, 1);
-    SHIFT(w->ext_torque, 1); SHIFT(w->shape, 1); SHIFT(w->radius, 1); SHIFT(w->outline, 1); SHIFT(w->trig, 1); SHIFT(w->thrusters, 1); SHIFT(w->thruster_count, 1);
-    SHIFT(w->rests_dissipative, 1);
+    SHIFT(w->ext_torque, 1); SHIFT(w->shape, 1); SHIFT(w->radius, 1); SHIFT(w->outline, 1); SHIFT(w->trig, 1);
+    SHIFT(w->thrusters, 1); SHIFT(w->thruster_count, 1); SHIFT(w->rests_dissipative, 1);
     SHIFT(w->state, LC_STATE_SIZE);
 #undef SHIFT
     w->count--;
