@@ -42,6 +42,20 @@ static lc_status check_inertia(lc_world *w, double inertia, double mass, double 
 
 #define GROW(ptr, n) do { void *p_ = realloc((ptr), (size_t)(n) * sizeof *(ptr)); if (!p_) return 0; (ptr) = p_; } while (0)
 
+/* Room for cap rows of the trig cache, starting on a cache line (world.h): 1, or 0 without memory. */
+static int grow_trig(lc_world *w, int cap)
+{
+    unsigned char *block = malloc((size_t)cap * sizeof(lc_trig) + LC_TRIG_ALIGN - 1);
+    size_t skip;
+    if (block == NULL) return 0;
+    skip = (LC_TRIG_ALIGN - (size_t)((uintptr_t)block % LC_TRIG_ALIGN)) % LC_TRIG_ALIGN;
+    if (w->count > 0) memcpy(block + skip, w->trig, (size_t)w->count * sizeof(lc_trig));
+    free(w->trig_block);
+    w->trig_block = block;
+    w->trig = (lc_trig *)(void *)(block + skip);
+    return 1;
+}
+
 static int reserve_bodies(lc_world *w, int need)
 {
     int cap;
@@ -50,9 +64,10 @@ static int reserve_bodies(lc_world *w, int need)
     while (cap < need) cap *= 2;
     GROW(w->ids, cap); GROW(w->mass, cap); GROW(w->inertia, cap); GROW(w->inv_mass, cap);
     GROW(w->inv_inertia, cap); GROW(w->is_static, cap); GROW(w->elasticity, cap); GROW(w->friction, cap);
-    GROW(w->ext_force, cap); GROW(w->ext_torque, cap); GROW(w->shape, cap); GROW(w->trig, cap); GROW(w->thrusters, cap);
-    GROW(w->thruster_count, cap); GROW(w->rests_dissipative, cap);
+    GROW(w->ext_force, cap); GROW(w->ext_torque, cap); GROW(w->shape, cap); GROW(w->radius, cap);
+    GROW(w->outline, cap); GROW(w->thrusters, cap); GROW(w->thruster_count, cap); GROW(w->rests_dissipative, cap);
     GROW(w->state, (size_t)cap * LC_STATE_SIZE);
+    if (!grow_trig(w, cap)) return 0;
     w->capacity = cap;
     return 1;
 }
@@ -119,10 +134,10 @@ lc_status lc_world_add_body(lc_world *w, const lc_body_def *d, lc_body_id *out_i
     if (out_id) *out_id = w->next_body_id;
     w->next_body_id++;
     w->shape[row] = shape;
-    w->trig[row].angle[0] = w->trig[row].angle[1] = NAN;   /* NaN matches no angle: empty */
-    w->trig[row].next = 0;
-    w->trig[row].pose[0][2] = w->trig[row].pose[1][2] = NAN;
-    w->trig[row].box_next = 0;
+    w->radius[row] = shape.radius;
+    w->outline[row].v = shape.v;
+    w->outline[row].count = shape.count;
+    lc_trig_clear(&w->trig[row]);
     c = cos(d->angle);
     sn = sin(d->angle);
     cm = lc_add(d->position, lc_rot(c, sn, shape.center_offset));
@@ -214,8 +229,8 @@ lc_status lc_world_remove_body(lc_world *w, lc_body_id id)
 #define SHIFT(arr, k) memmove(&(arr)[(size_t)row * (k)], &(arr)[(size_t)(row + 1) * (k)], (size_t)n * (k) * sizeof *(arr))
     SHIFT(w->ids, 1); SHIFT(w->mass, 1); SHIFT(w->inertia, 1); SHIFT(w->inv_mass, 1); SHIFT(w->inv_inertia, 1);
     SHIFT(w->is_static, 1); SHIFT(w->elasticity, 1); SHIFT(w->friction, 1); SHIFT(w->ext_force, 1);
-    SHIFT(w->ext_torque, 1); SHIFT(w->shape, 1); SHIFT(w->trig, 1); SHIFT(w->thrusters, 1); SHIFT(w->thruster_count, 1);
-    SHIFT(w->rests_dissipative, 1);
+    SHIFT(w->ext_torque, 1); SHIFT(w->shape, 1); SHIFT(w->radius, 1); SHIFT(w->outline, 1); SHIFT(w->trig, 1);
+    SHIFT(w->thrusters, 1); SHIFT(w->thruster_count, 1); SHIFT(w->rests_dissipative, 1);
     SHIFT(w->state, LC_STATE_SIZE);
 #undef SHIFT
     w->count--;

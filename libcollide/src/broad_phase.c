@@ -62,38 +62,39 @@ void lc_broad_phase_state_destroy(lc_broad_phase_state *bp)
     free(bp);
 }
 
+/* The box about the centre of mass of the body's vertices turned as the entry's angle says, into
+ * the entry. */
+static void shape_extent(const lc_outline *o, lc_trig_entry *e)
+{
+    double x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY;
+    int i;
+    for (i = 0; i < o->count; ++i) {
+        lc_vec2 p = lc_rot(e->c, e->s, o->v[i]);
+        if (p.x < x0) x0 = p.x;
+        if (p.x > x1) x1 = p.x;
+        if (p.y < y0) y0 = p.y;
+        if (p.y > y1) y1 = p.y;
+    }
+    e->ext[0] = x0;
+    e->ext[1] = y0;
+    e->ext[2] = x1;
+    e->ext[3] = y1;
+}
+
+/* Body row's box at state s: its centre plus the turned vertices' box, kept with the angle's trig (a
+ * step asks for each body's box at the same few angles many times). Rounding is monotone, so the
+ * least of x + p over the vertices p is x + the least p: the same bits as the box of the vertices
+ * placed one by one. */
 static void body_box(const lc_world *w, const double *s, int row, box *b)
 {
-    const lc_shape *sh = &w->shape[row];
     const double *st = &s[row * 6];
-    lc_trig *cache = &w->trig[row];
-    double c, sn, *out;
-    int i, k;
-    /* each pass asks for the boxes at its start state twice (resting set, then the trial) */
-    for (k = 0; k < 2; ++k)
-        if (memcmp(cache->pose[k], st, 3 * sizeof(double)) == 0) {
-            b->x0 = cache->box[k][0]; b->y0 = cache->box[k][1];
-            b->x1 = cache->box[k][2]; b->y1 = cache->box[k][3];
-            b->row = row;
-            return;
-        }
-    lc_body_trig(w, row, st[SA], &c, &sn);
-    b->x0 = b->y0 = INFINITY;
-    b->x1 = b->y1 = -INFINITY;
-    for (i = 0; i < sh->count; ++i) {
-        lc_vec2 p = lc_rot(c, sn, sh->v[i]);
-        double x = st[SX] + p.x, y = st[SY] + p.y;
-        if (x < b->x0) b->x0 = x;
-        if (x > b->x1) b->x1 = x;
-        if (y < b->y0) b->y0 = y;
-        if (y > b->y1) b->y1 = y;
-    }
+    lc_trig_entry *e = lc_body_trig_entry(w, row, st[SA]);
+    if (isnan(e->ext[0])) shape_extent(&w->outline[row], e);
+    b->x0 = st[SX] + e->ext[0];
+    b->y0 = st[SY] + e->ext[1];
+    b->x1 = st[SX] + e->ext[2];
+    b->y1 = st[SY] + e->ext[3];
     b->row = row;
-    k = cache->box_next;
-    cache->box_next = 1 - k;
-    memcpy(cache->pose[k], st, 3 * sizeof(double));
-    out = cache->box[k];
-    out[0] = b->x0; out[1] = b->y0; out[2] = b->x1; out[3] = b->y1;
 }
 
 double lc_bounds_gap(const lc_world *w, const double *state, int a, int b)
@@ -230,7 +231,7 @@ static void bound_box(const lc_world *w, const double *s0, const double *s1, int
     const double *p = &s0[i * 6], *q = (s1 != s0 && !w->is_static[i]) ? &s1[i * 6] : p;
     double x0 = p[SX] < q[SX] ? p[SX] : q[SX], x1 = p[SX] < q[SX] ? q[SX] : p[SX];
     double y0 = p[SY] < q[SY] ? p[SY] : q[SY], y1 = p[SY] < q[SY] ? q[SY] : p[SY];
-    double r = w->shape[i].radius + margin;
+    double r = w->radius[i] + margin;
     r += 1e-9 * (r + fabs(x0) + fabs(x1) + fabs(y0) + fabs(y1));
     out->x0 = x0 - r;
     out->x1 = x1 + r;

@@ -42,7 +42,8 @@ static inline int cmp_pair(const void *x, const void *y)
     return (a[1] > b[1]) - (a[1] < b[1]);
 }
 
-static inline int same_row(const double *a, const double *b) { return memcmp(a, b, 6 * sizeof(double)) == 0; }
+/* 1 when a state row (x, y, angle, ...) has pose (x, y, angle): a body's box depends on its pose alone. */
+static inline int same_pose(const double *row, const double *pose) { return memcmp(row, pose, 3 * sizeof(double)) == 0; }
 
 static inline int pair_after(const int *x, const int *y) { return x[0] > y[0] || (x[0] == y[0] && x[1] > y[1]); }
 

@@ -8,8 +8,9 @@
 
 struct lc_bp_kept {
     /* The last whole-world search over an interval (s1 != s0): its pairs (kept_count, -1: none) and each
-     * row's state its box came from (s1's row, a static body's s0's), with the world's edits, rows and
-     * margin then. */
+     * row's pose its box came from (s1's row, a static body's s0's; x, y and angle: a box depends on
+     * nothing else, and half a state row is half the reads of a whole-world pass), with the world's
+     * edits, rows and margin then. */
     lc_buf kept_pairs, kept_ref;
     int kept_count, kept_rows;
     double kept_margin;
@@ -54,16 +55,14 @@ void lc_bp_keep_search(lc_bp_kept *bp, const lc_world *w, const double *s0, cons
 {
     int n = w->count, i;
     int *p = lc_buf_get(&bp->kept_pairs, (size_t)(count > 0 ? count : 1) * 2 * sizeof(int));
-    double *ref = lc_buf_get(&bp->kept_ref, (size_t)(n > 0 ? n : 1) * 6 * sizeof(double));
+    double *ref = lc_buf_get(&bp->kept_ref, (size_t)(n > 0 ? n : 1) * 3 * sizeof(double));
     bp->kept_count = -1;
     bp->track_kept = 0;
     /* nothing kept without memory (the next search looks at every box), nor from a search that left
      * rows out: a later one may take them */
     if (p == NULL || ref == NULL || w->excluded != NULL) return;
     if (count > 0) memcpy(p, buf->p, (size_t)count * 2 * sizeof(int));
-    memcpy(ref, s1, (size_t)n * 6 * sizeof(double));
-    for (i = 0; i < n; ++i)
-        if (w->is_static[i]) memcpy(&ref[i * 6], &s0[i * 6], 6 * sizeof(double));
+    for (i = 0; i < n; ++i) memcpy(&ref[i * 3], w->is_static[i] ? &s0[i * 6] : &s1[i * 6], 3 * sizeof(double));
     bp->kept_count = count;
     bp->kept_rows = n;
     bp->kept_margin = margin;
@@ -81,7 +80,7 @@ void lc_bp_kept_track(lc_bp_kept *bp, const lc_world *w, const double *s0, const
         uint8_t *stale = lc_buf_get(&bp->stale, (size_t)(w->count > 0 ? w->count : 1));
         const double *ref = (const double *)bp->kept_ref.p;
         if (stale != NULL) {
-            for (i = 0; i < w->count; ++i) stale[i] = !same_row(w->is_static[i] ? &s0[i * 6] : &s1[i * 6], &ref[i * 6]);
+            for (i = 0; i < w->count; ++i) stale[i] = !same_pose(w->is_static[i] ? &s0[i * 6] : &s1[i * 6], &ref[i * 3]);
             bp->track_kept = 1;
         }
     }
@@ -131,7 +130,7 @@ int lc_bp_pairs_from_kept(lc_bp_kept *bp, lc_world *w, lc_reach_grid *tracked, c
     {
         int use_stale = tracked != NULL && bp->track_kept;
         for (i = 0; i < n; ++i) {
-            moved[i] = !same_row(&s[i * 6], &ref[i * 6]) || (use_stale && stale[i]);
+            moved[i] = !same_pose(&s[i * 6], &ref[i * 3]) || (use_stale && stale[i]);
             if (moved[i]) {
                 if (m >= n / 4 + 1 || !use_stale) return -2;
                 mrows[m++] = i;

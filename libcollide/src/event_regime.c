@@ -32,6 +32,7 @@ struct lc_event_regime {
     lc_buf at_lo;                    /* a crossing's rows at the start of its bracket */
     lc_buf clock;                    /* lazy clocks: the time (from the pass's t0) each row's state is at, and its anchor's */
     lc_buf anchor;                   /* lazy clocks: each row's state at its last event */
+    lc_buf own;                      /* lazy clocks: 1 where anchor holds the row's anchor */
     lc_buf in_rows;                  /* 1 for the advanced rows (spin_max) */
 };
 
@@ -68,6 +69,7 @@ void lc_event_regime_destroy(lc_event_regime *er)
     lc_buf_free(&er->at_lo);
     lc_buf_free(&er->clock);
     lc_buf_free(&er->anchor);
+    lc_buf_free(&er->own);
     lc_buf_free(&er->in_rows);
     free(er);
 }
@@ -92,17 +94,30 @@ static int rows_closed_form(const lc_world *w, const int *rows, int nrows)
  * clock[row] (the impact's rows are copied from w->state to s0 at the next pass's start). A row is
  * brought to a time in one closed-form advance from its anchor, the state its last event (an impact,
  * or the trial's start) left it in at anchor_t[row]: so its state at any time is the same bits however
- * often, and after whichever other bodies' events, it was looked at. */
+ * often, and after whichever other bodies' events, it was looked at. Most rows keep the trial's start
+ * as their anchor, and that is their row of s0 until s0's row is first written (keep_anchor): so the
+ * clocks start without a copy of every row (at 20 000 bodies, a copy of a state that no longer fits
+ * the cache at each trial's first impact). */
 typedef struct lazy_clock {
     lc_world *w;
     double *s0, *clock, *anchor, *anchor_t;
-    double now;   /* the time the rows looked at are brought to */
+    uint8_t *own;   /* 1: the row's anchor is in anchor; 0: it is the row of s0 */
+    double now;     /* the time the rows looked at are brought to */
 } lazy_clock;
+
+/* Row r of s0 is about to be written: its anchor, if s0 held it, to anchor. */
+static void keep_anchor(lazy_clock *lz, int r)
+{
+    if (lz->own[r]) return;
+    memcpy(&lz->anchor[r * 6], &lz->s0[r * 6], 6 * sizeof(double));
+    lz->own[r] = 1;
+}
 
 /* Row r of w->state at time t, from its anchor. */
 static int row_at(lazy_clock *lz, int r, double t)
 {
-    return lc_integrate_rows(lz->w, lz->anchor, t - lz->anchor_t[r], &r, 1, NULL, 0, lz->w->state);
+    return lc_integrate_rows(lz->w, lz->own[r] ? lz->anchor : lz->s0, t - lz->anchor_t[r], &r, 1, NULL, 0,
+                             lz->w->state);
 }
 
 /* The rows' states in w->state are their new anchors, at time t. */
@@ -111,6 +126,7 @@ static void anchor_rows(lazy_clock *lz, const int *rows, int n, double t)
     int i;
     for (i = 0; i < n; ++i) {
         memcpy(&lz->anchor[rows[i] * 6], &lz->w->state[rows[i] * 6], 6 * sizeof(double));
+        lz->own[rows[i]] = 1;
         lz->anchor_t[rows[i]] = t;
     }
 }
@@ -121,6 +137,7 @@ static int sync_row(void *ctx, int r)
     lc_world *w = lz->w;
     if (w->is_static[r] || lz->clock[r] == lz->now) return 0;
     if (row_at(lz, r, lz->now) != 0) return -1;
+    keep_anchor(lz, r);
     memcpy(&lz->s0[r * 6], &w->state[r * 6], 6 * sizeof(double));
     lz->clock[r] = lz->now;
     return 0;
@@ -291,8 +308,10 @@ static lc_status event_advance(lc_world *w, lc_event_regime *er, const lc_step_t
     lz.s0 = s0;
     lz.clock = lc_buf_get(&er->clock, (size_t)(w->count > 0 ? w->count : 1) * 2 * sizeof(double));
     lz.anchor = lc_buf_get(&er->anchor, bytes);
+    lz.own = lc_buf_get(&er->own, (size_t)(w->count > 0 ? w->count : 1));
     lz.now = 0.0;
-    if (lz.clock == NULL || lz.anchor == NULL) return lc_fail(w, LC_ERR_NO_MEMORY, "out of memory in step");
+    if (lz.clock == NULL || lz.anchor == NULL || lz.own == NULL)
+        return lc_fail(w, LC_ERR_NO_MEMORY, "out of memory in step");
     lz.anchor_t = lz.clock + (w->count > 0 ? w->count : 1);
     for (i = 0; i < w->spring_count; ++i)
         if (w->springs[i].def.body_b != LC_WORLD_ANCHOR) body_springs = 1;
@@ -315,10 +334,16 @@ static lc_status event_advance(lc_world *w, lc_event_regime *er, const lc_step_t
         if (lazy) {
             /* the impact's rows to s0 and to their anchors, and what the resting search below looks at
              * to now */
-            for (i = 0; i < ndirty; ++i) copy_row_spin(s0, w->state, drows[i], &spin);
+            for (i = 0; i < ndirty; ++i) {
+                keep_anchor(&lz, drows[i]);
+                copy_row_spin(s0, w->state, drows[i], &spin);
+            }
             anchor_rows(&lz, drows, ndirty, lz.now);
             for (i = 0; i < 2; ++i)
-                if (fresh[i] >= 0) copy_row_spin(s0, w->state, fresh[i], &spin);
+                if (fresh[i] >= 0) {
+                    keep_anchor(&lz, fresh[i]);
+                    copy_row_spin(s0, w->state, fresh[i], &spin);
+                }
             if (sync_near(&lz, w->state, w->state, drows, ndirty, w->def.contact_distance) != 0) goto oom;
         }
         if (local_next && !body_springs)
@@ -552,7 +577,7 @@ static lc_status event_advance(lc_world *w, lc_event_regime *er, const lc_step_t
             if (lc_broad_phase_track(w, s0, s1, trial, rows, nrows, w->def.contact_distance) != 0) goto oom;
             tracked = 1;
             lazy = 1;
-            memcpy(lz.anchor, s0, (size_t)w->count * 6 * sizeof(double));
+            memset(lz.own, 0, (size_t)w->count);   /* every row's anchor is its row of s0 */
             for (i = 0; i < nrows; ++i) lz.clock[rows[i]] = lz.anchor_t[rows[i]] = lz.now;
         }
         ts = lc_stage_begin(w);

@@ -7,6 +7,7 @@
 
 struct lc_integrator_state {
     lc_buf flags, rows;      /* rows in a resting touch; the rows advanced by the integrator */
+    lc_buf written;          /* lc_integrate: the rows it advances (the others are copied) */
     lc_buf acc, tmp, k[4];   /* accelerations, and the stages' states and derivatives (count x 6) */
 };
 
@@ -18,6 +19,7 @@ void lc_integrator_state_destroy(lc_integrator_state *is)
     if (is == NULL) return;
     lc_buf_free(&is->flags);
     lc_buf_free(&is->rows);
+    lc_buf_free(&is->written);
     lc_buf_free(&is->acc);
     lc_buf_free(&is->tmp);
     for (i = 0; i < 4; ++i) lc_buf_free(&is->k[i]);
@@ -137,7 +139,20 @@ static int integrate(lc_world *w, const double *s0, double h, const int *rows, i
     irows = lc_buf_get(&w->integrator->rows, (size_t)(nrows > 0 ? nrows : 1) * sizeof(int));
     acc = lc_buf_get(&w->integrator->acc, (size_t)w->count * 3 * sizeof(double));
     if (!flags || !irows || !acc) return -1;
-    if (s1 != s0 && copy_all) memcpy(s1, s0, bytes);
+    if (s1 != s0 && copy_all) {
+        /* only the rows not advanced below come from s0 (in free flight, the static ones): a copy of the
+         * whole state, then written over, is a pass over every body's state for nothing */
+        uint8_t *written = h == 0.0 ? NULL : lc_buf_get(&w->integrator->written, (size_t)w->count);
+        if (written == NULL) {
+            memcpy(s1, s0, bytes);
+        } else {
+            memset(written, 0, (size_t)w->count);
+            for (i = 0; i < nrows; ++i)
+                if (!w->is_static[rows[i]]) written[rows[i]] = 1;
+            for (i = 0; i < w->count; ++i)
+                if (!written[i]) memcpy(&s1[i * 6], &s0[i * 6], 6 * sizeof(double));
+        }
+    }
     /* a moving row is written whole below when time passes; a static one only here */
     if (s1 != s0 && !copy_all)
         for (i = 0; i < nrows; ++i)

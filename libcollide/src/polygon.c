@@ -134,18 +134,23 @@ lc_status lc_shape_build(lc_shape *out, lc_vec2 *store, const lc_vec2 *v, int co
 
 int lc_shape_keep(lc_shape *s, int count)
 {
-    lc_vec2 *block = malloc((size_t)(count > 0 ? 2 * count : 1) * sizeof *block);
-    if (block == NULL) return -1;
+    unsigned char *raw = malloc((size_t)(count > 0 ? 2 * count : 1) * sizeof(lc_vec2) + LC_SHAPE_ALIGN - 1);
+    size_t skip;
+    lc_vec2 *block;
+    if (raw == NULL) return -1;
+    skip = (LC_SHAPE_ALIGN - (size_t)((uintptr_t)raw % LC_SHAPE_ALIGN)) % LC_SHAPE_ALIGN;
+    block = (lc_vec2 *)(void *)(raw + skip);
     if (s->v != NULL) memcpy(block, s->v, (size_t)count * sizeof *block);
     if (s->n != NULL) memcpy(block + count, s->n, (size_t)count * sizeof *block);
     s->v = block;
     s->n = block + count;
+    s->block_skip = (int)skip;
     return 0;
 }
 
 void lc_shape_release(lc_shape *s)
 {
-    free(s->v);
+    if (s->v != NULL) free((unsigned char *)s->v - s->block_skip);
     s->v = s->n = NULL;
 }
 

@@ -10,8 +10,8 @@
  *            from one step to the next, each part written by its owner: sleep (sleep.c), the contact
  *            regime's warm start and kept touches (contact_regime.c), the event regime's warm start
  *            and end touches (event_regime.c), the sparse solver's norm estimates (sparse_lcp.c).
- * Not written, because a fresh one gives the same bits: scratch buffers, the per-body trig and box
- * caches (a hit returns the very bits a miss computes, world.h), the sort-and-sweep order (any start
+ * Not written, because a fresh one gives the same bits: scratch buffers, the per-body trig cache and
+ * its boxes (a hit returns the very bits a miss computes, world.h), the sort-and-sweep order (any start
  * sorts to the same order, broad_phase.c), the impact event stream (the caller's reading, not the
  * world's state), the stage-timing setting and the force callback (the caller's functions: a load keeps
  * the world's own). tests/c/test_snapshot.c continues every regime bit for bit from a loaded snapshot,
@@ -309,6 +309,9 @@ static int get_body(lc_reader *in, lc_world *w, int i)
     s->center_offset.x = lc_get_finite(in, "a centre of mass offset");
     s->center_offset.y = lc_get_finite(in, "a centre of mass offset");
     s->radius = get_in(in, 0.0, INFINITY, "a polygon's radius");
+    w->radius[i] = s->radius;
+    w->outline[i].v = s->v;
+    w->outline[i].count = s->count;
     s->min_edge = get_in(in, 0.0, INFINITY, "a polygon's shortest edge");
     s->area = get_in(in, 0.0, INFINITY, "a polygon's area");
     s->unit_inertia = get_in(in, 0.0, INFINITY, "a polygon's unit inertia");
@@ -324,10 +327,7 @@ static int get_body(lc_reader *in, lc_world *w, int i)
         t->level = get_in(in, 0.0, 1.0, "a thruster level");
     }
     /* the caches start empty, as for a new body: NaN matches no angle */
-    tr->angle[0] = tr->angle[1] = NAN;
-    tr->next = 0;
-    tr->pose[0][2] = tr->pose[1][2] = NAN;
-    tr->box_next = 0;
+    lc_trig_clear(tr);
     return 0;
 }
 

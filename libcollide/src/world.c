@@ -250,7 +250,7 @@ void lc_world_destroy(lc_world *w)
     for (i = 0; i < w->count; ++i) lc_shape_release(&w->shape[i]);
     free(w->ids); free(w->state); free(w->mass); free(w->inertia); free(w->inv_mass); free(w->inv_inertia);
     free(w->is_static); free(w->elasticity); free(w->friction); free(w->ext_force); free(w->ext_torque);
-    free(w->shape); free(w->trig); free(w->thrusters); free(w->thruster_count); free(w->id_to_row);
+    free(w->shape); free(w->radius); free(w->outline); free(w->trig_block); free(w->thrusters); free(w->thruster_count); free(w->id_to_row);
     free(w->springs); free(w->contacts); free(w->rests_dissipative);
     lc_step_state_destroy(w->step_state);
     lc_islands_destroy(w->islands);

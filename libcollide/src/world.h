@@ -24,6 +24,7 @@ typedef struct lc_thruster {
  * tests) then touched a new page per body; 20 000 bodies in free flight took ~30 % longer per step. */
 typedef struct lc_shape {
     int count;
+    int block_skip;                       /* bytes from the kept block's allocation to v (lc_shape_keep) */
     lc_vec2 *v;                           /* count vertices, counter-clockwise */
     lc_vec2 *n;                           /* outward unit normal of edge v[i] -> v[i+1] (same block as v) */
     lc_vec2 center_offset;                /* local-frame origin -> centre of mass, body frame */
@@ -35,6 +36,12 @@ typedef struct lc_shape {
     double inertia_per_mass;              /* the body's inertia over its mass, m^2: unit_inertia, or a given
                                              inertia's (lc_body_set_mass keeps it) */
 } lc_shape;
+
+/* A body's vertices, as its shape has them (v points into the shape's block). */
+typedef struct lc_outline {
+    const lc_vec2 *v;
+    int count;
+} lc_outline;
 
 typedef struct lc_spring_rec {
     lc_spring_id id;
@@ -58,14 +65,21 @@ typedef struct lc_buf {  /* growable scratch array */
     size_t cap;          /* bytes */
 } lc_buf;
 
-/* The last two angles a body was seen at and their cosine and sine (see lc_body_trig), and the last
- * two poses (x, y, angle) and their bounding boxes (broad_phase.c). */
+/* One angle a body was seen at: its cosine and sine, and the box about the centre of mass of the
+ * body's vertices turned by it (min x, min y, max x, max y; NaN until the broad phase asks for it:
+ * broad_phase.c). Seven doubles and a pad: an entry fills one cache line. */
+typedef struct lc_trig_entry {
+    double angle, c, s, ext[4];
+    double pad;
+} lc_trig_entry;
+
+/* The last two angles a body was seen at, the newer first (lc_body_trig_entry). w->trig's rows start
+ * on a cache line (LC_TRIG_ALIGN, body.c), so a lookup that finds the newer angle reads one line: a
+ * step looks up every body several times, and 20 000 bodies' caches do not fit a 2 MiB cache. */
 typedef struct lc_trig {
-    double angle[2], c[2], s[2];
-    int next;
-    double pose[2][3], box[2][4];
-    int box_next;
+    lc_trig_entry e[2];
 } lc_trig;
+#define LC_TRIG_ALIGN 64
 
 struct lc_world {
     lc_world_def def;
@@ -84,7 +98,12 @@ struct lc_world {
     lc_vec2 *ext_force;
     double *ext_torque;
     lc_shape *shape;
+    double *radius;          /* shape[row].radius again, by row: the whole-world passes that need only it
+                                (broad_phase.c's bound boxes) read a double per body, not a shape row */
+    lc_outline *outline;     /* shape[row]'s vertices again, by row, for the same reason (the boxes at each
+                                body's new angle) */
     lc_trig *trig;           /* per body; a cache, so written through even a const lc_world * */
+    void *trig_block;        /* the allocation trig lies in (trig starts on a cache line in it) */
     lc_thruster (*thrusters)[LC_MAX_THRUSTERS];
     int *thruster_count;
     uint8_t *rests_dissipative; /* touched a pair with e < 1 at the end of the last step (regime.c) */
@@ -195,7 +214,10 @@ void lc_remove_springs_of(lc_world *w, lc_body_id id);
 lc_status lc_shape_build(lc_shape *out, lc_vec2 *store, const lc_vec2 *v, int count, const lc_vec2 *center, char *why,
                          size_t why_len);
 /* Gives a shape a block of its own for count vertices and normals, copying those v and n point to when
- * they are set (a built shape's store); 0, or -1 without memory (the shape unchanged). */
+ * they are set (a built shape's store); 0, or -1 without memory (the shape unchanged). The block starts
+ * on a cache line (LC_SHAPE_ALIGN): a box's four vertices are then one line, which the broad phase reads
+ * for each body at each new angle. */
+#define LC_SHAPE_ALIGN 64
 int lc_shape_keep(lc_shape *s, int count);
 /* Frees a kept shape's block. */
 void lc_shape_release(lc_shape *s);
@@ -457,24 +479,32 @@ static inline void lc_stage_end(const lc_world *w, double *field, double t0)
     if (w->stage_timing) *field += lc_stage_clock() - t0;
 }
 
-/* Cosine and sine of body `row` at `angle`. A step asks for the same few states' trig many times
- * (broad phase, crossings, separation, touches: it was 40 % of the seed scene's time), so the last
- * two angles per body are remembered; a match is bit-for-bit, so results do not change. */
-static inline void lc_body_trig(const lc_world *w, int row, double angle, double *c, double *s)
+/* Empties a body's trig cache (NaN matches no angle). */
+static inline void lc_trig_clear(lc_trig *t) { t->e[0].angle = t->e[1].angle = NAN; }
+
+/* The trig cache's entry of body `row` at `angle`, made (cosine and sine; no box yet) when neither of
+ * the last two angles is it. A step asks for the same few states' trig many times (broad phase,
+ * crossings, separation, touches: it was 40 % of the seed scene's time), so the last two angles per
+ * body are remembered; a match is bit-for-bit, so results do not change. */
+static inline lc_trig_entry *lc_body_trig_entry(const lc_world *w, int row, double angle)
 {
     lc_trig *t = &w->trig[row];
-    int k;
-    for (k = 0; k < 2; ++k)
-        if (memcmp(&t->angle[k], &angle, sizeof angle) == 0) {
-            *c = t->c[k];
-            *s = t->s[k];
-            return;
-        }
-    k = t->next;
-    t->next = 1 - k;
-    t->angle[k] = angle;
-    t->c[k] = *c = cos(angle);
-    t->s[k] = *s = sin(angle);
+    if (memcmp(&t->e[0].angle, &angle, sizeof angle) == 0) return &t->e[0];
+    if (memcmp(&t->e[1].angle, &angle, sizeof angle) == 0) return &t->e[1];
+    t->e[1] = t->e[0];
+    t->e[0].angle = angle;
+    t->e[0].c = cos(angle);
+    t->e[0].s = sin(angle);
+    t->e[0].ext[0] = NAN;
+    return &t->e[0];
+}
+
+/* Cosine and sine of body `row` at `angle` (the trig cache). */
+static inline void lc_body_trig(const lc_world *w, int row, double angle, double *c, double *s)
+{
+    const lc_trig_entry *e = lc_body_trig_entry(w, row, angle);
+    *c = e->c;
+    *s = e->s;
 }
 
 #endif
