@@ -548,7 +548,7 @@ static void hold_at_rest(lc_contact_island *c)
     int k;
     for (k = 0; k < c->b.n; ++k) {
         const double *v = &c->b.v[k * 3];
-        if (hypot(v[0], v[1]) + fabs(v[2]) * w->shape[c->isl->rows[k]].radius >= LC_CONTACT_REST_SPEED) return;
+        if (hypot(v[0], v[1]) + fabs(v[2]) * w->radius[c->isl->rows[k]] >= LC_CONTACT_REST_SPEED) return;
     }
     if (island_driven(c)) return;
     memset(c->b.v, 0, (size_t)c->b.n * 3 * sizeof(double));
