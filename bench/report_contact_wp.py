@@ -15,6 +15,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 if HERE not in sys.path:
     sys.path.insert(0, HERE)
 
+from page_block import replace_block  # noqa: E402
 from report import f, load_average_text  # noqa: E402
 from report_contact import CONTACT_NAMES, md_table  # noqa: E402
 
@@ -205,13 +206,7 @@ def section(wp: dict[str, Any]) -> list[str]:
 
 def splice(page: str, block: list[str]) -> str:
     """The page with its contact_wp section replaced by block (appended when the page has none)."""
-    text = "\n".join(block)
-    i = page.find(BEGIN)
-    if i < 0:
-        return page.rstrip("\n") + "\n\n" + text + "\n"
-    j = page.find(END, i)
-    tail = page[j + len(END):] if j >= 0 else ""
-    return page[:i] + text + tail
+    return replace_block(page, BEGIN, END, "\n".join(block), append_missing=True)
 
 
 def update_page(wp: dict[str, Any], path: str) -> None:
