@@ -25,14 +25,6 @@
 #include "projection_active_set.h"
 #include "sparse_ldl.h"
 
-/* lc_contact_solver_run under the stop rule of max_sweeps, tolerance and stall_sweeps. */
-static lc_contact_solve run_solver(lc_contact_row *rows, int n, double *v, const double *im, const double *ii,
-                                   int max_sweeps, double tolerance, int stall_sweeps)
-{
-    lc_contact_stop stop = lc_contact_stop_rule(max_sweeps, tolerance, stall_sweeps);
-    return lc_contact_solver_run(rows, n, v, im, ii, &stop);
-}
-
 /* a fixed generator (xorshift64*): the same problems on every platform */
 static double uniform(unsigned long long *s)
 {
@@ -311,6 +303,7 @@ static void check_column(void)
 static int sweeps_from(const problem *p, const double *b, const double *lambda, double *disp)
 {
     lc_contact_row *gs = calloc((size_t)p->m, sizeof(lc_contact_row));
+    lc_contact_stop stop = lc_contact_stop_rule(1000000, 1e-12, 0);
     lc_contact_solve s;
     int i;
     memcpy(gs, p->rows, (size_t)p->m * sizeof(lc_contact_row));
@@ -319,7 +312,7 @@ static int sweeps_from(const problem *p, const double *b, const double *lambda, 
         gs[i].lambda_n = lambda != NULL ? lambda[i] : 0.0;
     }
     memset(disp, 0, (size_t)p->nb * 3 * sizeof(double));
-    s = run_solver(gs, p->m, disp, p->inv_mass, p->inv_inertia, 1000000, 1e-12, 0);
+    s = lc_contact_solver_run(gs, p->m, disp, p->inv_mass, p->inv_inertia, &stop);
     free(gs);
     return s.residual <= 1e-12 ? s.sweeps : -1;
 }
