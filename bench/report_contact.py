@@ -220,8 +220,10 @@ def write_contact(out: dict[str, Any], path: str, wp_results: str = WP_RESULTS) 
          f"{meta.get('libcollide', '?')}. Peers: " + ", ".join(f"{k} {v}" for k, v in meta.get("versions", {}).items())
          + ".", "",
          "Every engine runs the same neutral scene (`bench/scenes.py`) through its adapter "
-         "(`bench/engines/`), sleep off in the peers, the engines of a scene (of each seed of a random "
-         "pile) interleaved round-robin; "
+         "(`bench/engines/`), sleep off in the peers (and in libcollide, whose default is off; it does not "
+         "solve a still island, one that rested through its last step at the state it starts from, "
+         "docs/contact_regime.md: no setting, no delay, the same states), the engines of a scene (of each "
+         "seed of a random pile) interleaved round-robin; "
          "states are read after every step (outside the timed loop) and every quality figure is "
          "computed from them by `bench/metrics.py`, never taken from an engine.", "", "Scenes:", ""]
     L += [f"- **{key}** (" + ", ".join(f"`{n}`" for n in s.get("names", [s["name"]])) + f"): {s['what']}"

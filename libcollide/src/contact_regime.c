@@ -553,6 +553,41 @@ static void hold_at_rest(lc_contact_island *c)
     if (island_driven(c)) return;
     memset(c->b.v, 0, (size_t)c->b.n * 3 * sizeof(double));
     c->w->last.contact_rests++;
+    c->rested = 1;
+}
+
+/* A still island (kept_touches.h): it rested through its last step at the state it starts this one from,
+ * nothing drives it and nothing changed since (no API change, the same rows, pairs and dt). This step's
+ * solve would meet the problem it met then and hold the island at rest again, with the state unchanged,
+ * so it is not solved: its resting contacts are reported with the forces the last solve found, which
+ * also stay the warm start, and its touches are kept for the next step. Counted in contact_rests. */
+static int hold_still(lc_contact_island *c, const lc_touch *kept, int n, const double *margin)
+{
+    lc_world *w = c->w;
+    int i;
+    for (i = 0; i < n; ++i) {
+        lc_touch x = kept[i];
+        double fn, ft;
+        if (!(x.gap < w->def.contact_distance)) continue;
+        lc_contact_cache_find(c->cr->cache, key_of(w, &x), &fn, &ft);
+        x.value = fn;
+        x.tangent = ft;
+        if (x.elasticity < 1.0) w->rests_dissipative[x.a] = w->rests_dissipative[x.b] = 1;
+        if (lc_push_contact(w, &x, LC_CONTACT_RESTING) != 0) return -1;
+        if (lc_contact_cache_store(c->cr->cache, key_of(w, &x), fn, ft) != 0) return -1;
+        w->last.resting_contacts++;
+    }
+    w->last.contact_rests++;
+    return lc_kept_touches_store(c->cr->kept, w, c->isl, c->dt, kept, n, margin, 1);
+}
+
+/* Whether the island's state is bit for bit the one it started the step from (start: nrows x 6). */
+static int unmoved(const lc_contact_island *c, const double *start)
+{
+    int i;
+    for (i = 0; i < c->isl->nrows; ++i)
+        if (memcmp(&start[i * 6], &c->w->state[c->isl->rows[i] * 6], 6 * sizeof(double)) != 0) return 0;
+    return 1;
 }
 
 /* Step 6b: an island no force but gravity and contacts drives ends with at most the energy it began
@@ -645,6 +680,7 @@ static int advance(lc_contact_island *c, double dt, double e0, double size0, int
     lc_touch *t;
     lc_contact_row *rows;
     *nt = 0;
+    c->rested = 0;
     while (left > 0.0) {
         double tau;
         h = left;
@@ -708,8 +744,10 @@ int lc_contact_advance(lc_world *w, lc_contact_regime *cr, const lc_island *isl,
 {
     lc_contact_island c;
     double e0 = 0.0, ke0 = 0.0, size0 = 0.0, h = dt;
-    int i, k, nt = 0, nend = 0, status, ncontacts = w->contact_count, nevents = lc_events_staged(w->events);
+    int i, k, nt = 0, nend = 0, nkept = 0, status, ncontacts = w->contact_count, nevents = lc_events_staged(w->events);
     double *start;
+    const lc_touch *kept;
+    const double *kept_margin;
     memset(&c, 0, sizeof c);
     c.w = w;
     c.cr = cr;
@@ -723,6 +761,12 @@ int lc_contact_advance(lc_world *w, lc_contact_regime *cr, const lc_island *isl,
     for (i = 0; i < isl->nrows; ++i) {
         memcpy(&start[i * 6], &w->state[isl->rows[i] * 6], 6 * sizeof(double));
         w->rests_dissipative[isl->rows[i]] = 0;
+    }
+    if (!lc_force_callback_on(w) && lc_kept_touches_still(cr->kept, w, isl, dt, &kept, &nkept, &kept_margin) &&
+        !island_driven(&c)) {
+        status = hold_still(&c, kept, nkept, kept_margin);
+        unmap_island(&c);
+        return status;
     }
     e0 = island_energy(w, isl, start, 0, &ke0, &size0);
     status = advance(&c, dt, e0, size0, &nend, &nt, &h);
@@ -752,7 +796,8 @@ int lc_contact_advance(lc_world *w, lc_contact_regime *cr, const lc_island *isl,
             if (!isfinite(w->state[isl->rows[i] * 6 + k])) status = -2;
     if (status == 0 &&
         (finish(&c, (lc_touch *)cr->b_end.p, nend, (lc_touch *)cr->b_touch.p, (lc_contact_row *)cr->b_rows.p, nt, h) != 0 ||
-         lc_kept_touches_store(cr->kept, w, isl, dt, (const lc_touch *)cr->b_end.p, nend, (const double *)cr->b_margin.p) != 0))
+         lc_kept_touches_store(cr->kept, w, isl, dt, (const lc_touch *)cr->b_end.p, nend, (const double *)cr->b_margin.p,
+                               c.rested && unmoved(&c, start)) != 0))
         goto oom;
     if (c.residual > w->last.max_contact_residual) w->last.max_contact_residual = c.residual;
     unmap_island(&c);

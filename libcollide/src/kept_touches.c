@@ -7,6 +7,7 @@
 
 typedef struct record {
     int first_row, nrows, npairs, ntouch;
+    int still;           /* the island rested through the step that kept it, at one state (kept_touches.h) */
     double dt;
     unsigned long edits;
     size_t touch_at, state_at, int_at;   /* offsets into the arenas */
@@ -79,7 +80,7 @@ void lc_kept_touches_clear(lc_kept_touches *k)
 }
 
 int lc_kept_touches_store(lc_kept_touches *k, const lc_world *w, const lc_island *isl, double dt, const lc_touch *t,
-                          int n, const double *margin)
+                          int n, const double *margin, int still)
 {
     arena *x = &k->a[1 - k->read];
     record *rec;
@@ -97,6 +98,7 @@ int lc_kept_touches_store(lc_kept_touches *k, const lc_world *w, const lc_island
     rec->nrows = isl->nrows;
     rec->npairs = isl->npairs;
     rec->ntouch = n;
+    rec->still = still != 0;
     rec->dt = dt;
     rec->edits = w->edits;
     rec->touch_at = x->ntouches;
@@ -126,28 +128,53 @@ int lc_kept_touches_store(lc_kept_touches *k, const lc_world *w, const lc_island
     return 0;
 }
 
-int lc_kept_touches_take(const lc_kept_touches *k, const lc_world *w, const lc_island *isl, double dt,
-                         double (*want)(const void *ctx, int a, int b), const void *ctx, lc_buf *buf)
+/* The readable record of island isl if a step of dt starts from exactly the state it was kept at, with
+ * the same rows and pairs and no API change since; else NULL. */
+static const record *matching(const lc_kept_touches *k, const lc_world *w, const lc_island *isl, double dt)
 {
     const arena *x = &k->a[k->read];
     const record *rec;
     const double *st;
     const int *in;
-    const lc_touch *t;
-    lc_touch *out;
-    int i, n = 0;
-    if (isl->nrows == 0 || isl->rows[0] >= k->index_rows) return -2;
+    int i;
+    if (isl->nrows == 0 || isl->rows[0] >= k->index_rows) return NULL;
     i = ((const int *)k->b_index.p)[isl->rows[0]];
-    if (i < 0) return -2;
+    if (i < 0) return NULL;
     rec = &((const record *)x->records.p)[i];
-    if (rec->nrows != isl->nrows || rec->npairs != isl->npairs || rec->dt != dt || rec->edits != w->edits) return -2;
+    if (rec->nrows != isl->nrows || rec->npairs != isl->npairs || rec->dt != dt || rec->edits != w->edits) return NULL;
     in = (const int *)x->ints.p + rec->int_at;
     if (memcmp(in, isl->rows, (size_t)isl->nrows * sizeof(int)) != 0 ||
         (isl->npairs > 0 && memcmp(in + isl->nrows, isl->pairs, 2 * (size_t)isl->npairs * sizeof(int)) != 0))
-        return -2;
+        return NULL;
     st = (const double *)x->states.p + rec->state_at;
     for (i = 0; i < isl->nrows; ++i)
-        if (memcmp(&st[i * 6], &w->state[isl->rows[i] * 6], 6 * sizeof(double)) != 0) return -2;
+        if (memcmp(&st[i * 6], &w->state[isl->rows[i] * 6], 6 * sizeof(double)) != 0) return NULL;
+    return rec;
+}
+
+int lc_kept_touches_still(const lc_kept_touches *k, const lc_world *w, const lc_island *isl, double dt,
+                          const lc_touch **t, int *n, const double **margin)
+{
+    const arena *x = &k->a[k->read];
+    const record *rec = matching(k, w, isl, dt);
+    if (rec == NULL || !rec->still) return 0;
+    *t = (const lc_touch *)x->touches.p + rec->touch_at;
+    *n = rec->ntouch;
+    *margin = (const double *)x->states.p + rec->state_at + (size_t)rec->nrows * 6;
+    return 1;
+}
+
+int lc_kept_touches_take(const lc_kept_touches *k, const lc_world *w, const lc_island *isl, double dt,
+                         double (*want)(const void *ctx, int a, int b), const void *ctx, lc_buf *buf)
+{
+    const arena *x = &k->a[k->read];
+    const record *rec = matching(k, w, isl, dt);
+    const double *st;
+    const lc_touch *t;
+    lc_touch *out;
+    int i, n = 0;
+    if (rec == NULL) return -2;
+    st = (const double *)x->states.p + rec->state_at;
     for (i = 0; i < isl->npairs; ++i)
         if (!(want(ctx, isl->pairs[2 * i], isl->pairs[2 * i + 1]) <= st[isl->nrows * 6 + i])) return -2;
     out = lc_buf_get(buf, (size_t)(rec->ntouch > 0 ? rec->ntouch : 1) * sizeof(lc_touch));
@@ -186,6 +213,7 @@ void lc_kept_touches_save(const lc_kept_touches *k, const lc_world *w, lc_writer
         lc_put_i32(out, rec[r].nrows);
         lc_put_i32(out, rec[r].npairs);
         lc_put_i32(out, rec[r].ntouch);
+        lc_put_i32(out, rec[r].still);
         lc_put_f64(out, rec[r].dt);
         lc_put_u64(out, rec[r].edits);
         for (i = 0; i < rec[r].nrows + 2 * rec[r].npairs; ++i) lc_put_i32(out, in[i]);
@@ -203,6 +231,7 @@ int lc_kept_touches_load(lc_kept_touches *k, const lc_world *w, lc_reader *in)
         int nrows = lc_get_count(in, 1, w->count, 52, "a kept set's rows");
         int npairs = lc_get_count(in, 0, 1 << 28, 16, "a kept set's pairs");
         int ntouch = lc_get_count(in, 0, 1 << 28, LC_TOUCH_BYTES, "a kept set's touches");
+        int still = lc_get_i32(in);
         record *rec = lc_buf_get(&x->records, (size_t)(x->nrecords + 1) * sizeof(record));
         lc_touch *tt = lc_buf_get(&x->touches, (x->ntouches + (size_t)ntouch + 1) * sizeof(lc_touch));
         double *st = lc_buf_get(&x->states, (x->nstates + (size_t)nrows * 6 + (size_t)npairs + 1) * sizeof(double));
@@ -213,6 +242,8 @@ int lc_kept_touches_load(lc_kept_touches *k, const lc_world *w, lc_reader *in)
         rec->nrows = nrows;
         rec->npairs = npairs;
         rec->ntouch = ntouch;
+        if (still != 0 && still != 1) lc_reader_fail(in, "a kept set's still flag is neither 0 nor 1");
+        rec->still = still;
         rec->dt = lc_get_f64(in);
         rec->edits = (unsigned long)lc_get_u64(in);
         rec->touch_at = x->ntouches;

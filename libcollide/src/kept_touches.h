@@ -25,15 +25,21 @@ void lc_kept_touches_drop_stored(lc_kept_touches *k);
 void lc_kept_touches_clear(lc_kept_touches *k);
 /* Keeps touches t[0..n), found at w->state (the island's end state) for an island step of dt, the search
  * of pair k of isl having taken every point within margin[k] (m). Their normal velocities are recomputed
- * at that state. 0, or -1 without memory. */
+ * at that state. still: the island rested through that step at one state (it began and ended it at
+ * w->state with every velocity 0: contact_regime.c, "Rest"). 0, or -1 without memory. */
 int lc_kept_touches_store(lc_kept_touches *k, const lc_world *w, const lc_island *isl, double dt, const lc_touch *t,
-                          int n, const double *margin);
+                          int n, const double *margin, int still);
 /* The touches kept for island isl if it starts a step of dt from the state they were kept at, and if for
  * every pair the margin the caller's search would use, want(ctx, a, b), is within the kept one: those
  * whose gap is below want(ctx, a, b), copied into buf. Returns their count, -2 when nothing fits (search
  * then), or -1 without memory. */
 int lc_kept_touches_take(const lc_kept_touches *k, const lc_world *w, const lc_island *isl, double dt,
                          double (*want)(const void *ctx, int a, int b), const void *ctx, lc_buf *buf);
+/* 1 if island isl starts a step of dt from the state a still set was kept at (as for take), with that
+ * set's touches in *t (*n of them) and its pairs' margins in *margin, valid until the next
+ * lc_kept_touches_next_step; else 0. */
+int lc_kept_touches_still(const lc_kept_touches *k, const lc_world *w, const lc_island *isl, double dt,
+                          const lc_touch **t, int *n, const double **margin);
 
 /* Snapshots (snapshot.c): the sets stored since lc_kept_touches_next_step that the next step may take
  * (kept at the world's current `edits`), written, and read back into an empty store of a new world (w: its bodies already loaded). Load: 0, or

@@ -31,7 +31,7 @@
 #include "snapshot_io.h"
 
 #define SNAP_MAGIC "LCWORLD\x1a"
-#define SNAP_VERSION 1u
+#define SNAP_VERSION 2u
 #define SNAP_HEADER LC_SNAPSHOT_HEADER_BYTES
 #define COUNTER_WORDS (sizeof(lc_counters) / 8)
 /* The largest body id a snapshot may hold: the id map takes an int per id up to the largest, so a corrupt

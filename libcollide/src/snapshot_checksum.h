@@ -5,7 +5,7 @@
  * not part of the public API.
  *
  * The offset basis is 1469598103934665603, not the published FNV-1a 64 basis 14695981039346656037
- * (one digit shorter). It is part of snapshot format 1 and of every lc_world_state_hash value, so it
+ * (one digit shorter). It is part of the snapshot format and of every lc_world_state_hash value, so it
  * stays; test_snapshot's checksum_pinned fails if it changes. */
 #ifndef LC_SNAPSHOT_CHECKSUM_H
 #define LC_SNAPSHOT_CHECKSUM_H

@@ -368,8 +368,11 @@ static void corrupt_input(void)
     }
     /* another format version, a reserved field set, trailing bytes */
     memcpy(c, b.p, b.n);
-    c[8] = 2;
-    refused(w, &was, c, b.n, LC_ERR_BAD_SNAPSHOT, "format version 2", "format");
+    c[8] = 1;
+    refused(w, &was, c, b.n, LC_ERR_BAD_SNAPSHOT, "format version 1", "format");
+    memcpy(c, b.p, b.n);
+    c[8] = 3;
+    refused(w, &was, c, b.n, LC_ERR_BAD_SNAPSHOT, "format version 3", "format");
     memcpy(c, b.p, b.n);
     c[12] = 1;
     refused(w, &was, c, b.n, LC_ERR_BAD_SNAPSHOT, "reserved field set", "format");
@@ -408,7 +411,7 @@ static void corrupt_input(void)
     lc_world_destroy(w);
 }
 
-/* The layout's header as documented: magic, version 1, payload size, checksum, little-endian. */
+/* The layout's header as documented: magic, version 2, payload size, checksum, little-endian. */
 static void header_layout(void)
 {
     lc_world *w = seed_scene();
@@ -418,7 +421,7 @@ static void header_layout(void)
     if (!w) return;
     b = save(w);
     CHECK(memcmp(b.p, "LCWORLD\x1a", 8) == 0, "%s", "magic");
-    CHECK(b.p[8] == 1 && b.p[9] == 0 && b.p[10] == 0 && b.p[11] == 0, "%s", "version 1, little-endian");
+    CHECK(b.p[8] == 2 && b.p[9] == 0 && b.p[10] == 0 && b.p[11] == 0, "%s", "version 2, little-endian");
     for (k = 0; k < 8; ++k) {
         payload |= (uint64_t)b.p[16 + k] << (8 * k);
         sum |= (uint64_t)b.p[24 + k] << (8 * k);
@@ -429,7 +432,7 @@ static void header_layout(void)
     lc_world_destroy(w);
 }
 
-/* The checksum's bits are part of snapshot format 1 (snapshot_checksum.h): FNV-1a 64 with this library's
+/* The checksum's bits are part of the snapshot format (snapshot_checksum.h): FNV-1a 64 with this library's
  * offset basis, little-endian at bytes 24..31, over the payload only. header_layout compares a saved
  * header with lc_snapshot_checksum; this pins lc_snapshot_checksum itself to values worked out by hand
  * (python: h ^= byte; h = h * 1099511628211 % 2**64, from 1469598103934665603), so a changed hash
