@@ -258,6 +258,10 @@ int lc_kept_touches_load(lc_kept_touches *k, const lc_world *w, lc_reader *in)
         rec->first_row = ints[0];
         st += x->nstates;
         for (i = 0; i < nrows * 6 + npairs; ++i) st[i] = lc_get_f64(in);
+        /* a still set was kept at rest: a held island never keeps a velocity */
+        for (i = 0; still && i < nrows; ++i)
+            if (st[i * 6 + SVX] != 0.0 || st[i * 6 + SVY] != 0.0 || st[i * 6 + SW] != 0.0)
+                lc_reader_fail(in, "a still kept set's bodies are moving");
         tt += x->ntouches;
         for (i = 0; i < ntouch; ++i) lc_get_touch(in, w, &tt[i]);
         if (in->bad) break;

@@ -170,8 +170,8 @@
  * A pile's solve stopped by the stall rule or at contact_iterations is 1e-2 to 1e-1 m/s off; that error
  * drives its bodies into each other every step, the projection pushes them apart, and such a pile never
  * came to rest (100 mixed boxes: the median box still moved 1-5 mm a second after 8 s). Converged, six
- * of seven such piles rest by 4-9 s and a resting one takes one or two sweeps a step
- * (bench/repro/pile_rest.py). Above the speed, a falling pile's solves keep their cheap cut-off: what they
+ * of seven such piles rest by 4-9 s (bench/repro/pile_rest.py); once still, a pile is not solved
+ * (contact_regime.c, hold_still). Above the speed, a falling pile's solves keep their cheap cut-off: what they
  * leave is small beside its motion. The body rule: a pile's impulses are not unique, and Gauss-Seidel
  * trades them between rows sweep after sweep (its largest change stays at 1e-5 m/s in a resting
  * 1 000-box pile) at velocities that no longer move. */
