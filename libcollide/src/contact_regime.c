@@ -20,7 +20,8 @@
  *      step there, and the rest is taken again from step 1; in a settling sub-step (a large island
  *      moving slower than LC_CONTACT_SETTLE_SPEED, whose solves then run to convergence) an undriven
  *      island whose answer moves no point faster than LC_CONTACT_REST_SPEED rests: its velocities
- *      become 0;
+ *      become 0; an island that rested through its last step at one state and starts this one from it,
+ *      with nothing changed or driving it, is still: none of these steps is taken (hold_still);
  *   5. positions: x += h (v_0 + v) / 2 (exact under constant forces), or x += h v (Moreau-Jean) in a
  *      sub-step of several bodies and fewer than LC_CONTACT_MOREAU_JEAN_POINTS points, and in a pile
  *      sub-step;

@@ -1,5 +1,6 @@
-/* Kept touches (kept_touches.h): per island, a record of its rows, pairs, end state, search margins and
- * touches, in arenas written during a step and read in the next; islands are found by their first row. */
+/* Kept touches (kept_touches.h): per island, a record of its rows, pairs, end state, search margins,
+ * touches and still mark, in arenas written during a step and read in the next; islands are found by
+ * their first row. */
 #include <stdlib.h>
 #include <string.h>
 #include "kept_touches.h"

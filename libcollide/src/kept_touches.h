@@ -5,7 +5,8 @@
  * change since), with the same rows, the same candidate pairs and the same dt, so what it gives is what
  * the search would find: the end search's margin is at least as wide as the next start search's
  * (contact_regime.c), and a kept set is cut down to the latter when taken. Written during a step, readable in the next, like the
- * contact cache. */
+ * contact cache. A set also records whether its island was still (rested through that step at one state):
+ * such an island is not solved while it starts its steps from that state (contact_regime.c, hold_still). */
 #ifndef LC_KEPT_TOUCHES_H
 #define LC_KEPT_TOUCHES_H
 
