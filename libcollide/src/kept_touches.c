@@ -10,7 +10,7 @@ typedef struct record {
     int first_row, nrows, npairs, ntouch;
     int still;           /* the island rested through the step that kept it, at one state (kept_touches.h) */
     double dt;
-    unsigned long edits;
+    unsigned long edits, api_changes;
     size_t touch_at, state_at, int_at;   /* offsets into the arenas */
 } record;
 
@@ -102,6 +102,7 @@ int lc_kept_touches_store(lc_kept_touches *k, const lc_world *w, const lc_island
     rec->still = still != 0;
     rec->dt = dt;
     rec->edits = w->edits;
+    rec->api_changes = w->api_changes;
     rec->touch_at = x->ntouches;
     rec->state_at = x->nstates;
     rec->int_at = x->nints;
@@ -158,7 +159,8 @@ int lc_kept_touches_still(const lc_kept_touches *k, const lc_world *w, const lc_
 {
     const arena *x = &k->a[k->read];
     const record *rec = matching(k, w, isl, dt);
-    if (rec == NULL || !rec->still) return 0;
+    /* a setting (gravity, damping, a contact parameter) changes the problem without changing edits */
+    if (rec == NULL || !rec->still || rec->api_changes != w->api_changes) return 0;
     *t = (const lc_touch *)x->touches.p + rec->touch_at;
     *n = rec->ntouch;
     *margin = (const double *)x->states.p + rec->state_at + (size_t)rec->nrows * 6;
@@ -217,6 +219,7 @@ void lc_kept_touches_save(const lc_kept_touches *k, const lc_world *w, lc_writer
         lc_put_i32(out, rec[r].still);
         lc_put_f64(out, rec[r].dt);
         lc_put_u64(out, rec[r].edits);
+        lc_put_u64(out, rec[r].api_changes);
         for (i = 0; i < rec[r].nrows + 2 * rec[r].npairs; ++i) lc_put_i32(out, in[i]);
         for (i = 0; i < rec[r].nrows * 6 + rec[r].npairs; ++i) lc_put_f64(out, st[i]);
         for (i = 0; i < rec[r].ntouch; ++i) lc_put_touch(out, &t[i]);
@@ -247,6 +250,7 @@ int lc_kept_touches_load(lc_kept_touches *k, const lc_world *w, lc_reader *in)
         rec->still = still;
         rec->dt = lc_get_f64(in);
         rec->edits = (unsigned long)lc_get_u64(in);
+        rec->api_changes = (unsigned long)lc_get_u64(in);
         rec->touch_at = x->ntouches;
         rec->state_at = x->nstates;
         rec->int_at = x->nints;

@@ -36,9 +36,10 @@ int lc_kept_touches_store(lc_kept_touches *k, const lc_world *w, const lc_island
  * then), or -1 without memory. */
 int lc_kept_touches_take(const lc_kept_touches *k, const lc_world *w, const lc_island *isl, double dt,
                          double (*want)(const void *ctx, int a, int b), const void *ctx, lc_buf *buf);
-/* 1 if island isl starts a step of dt from the state a still set was kept at (as for take), with that
- * set's touches in *t (*n of them) and its pairs' margins in *margin, valid until the next
- * lc_kept_touches_next_step; else 0. */
+/* 1 if island isl starts a step of dt from the state a still set was kept at (as for take) and no API
+ * call at all changed the world since (w->api_changes: a setting changes the problem without changing
+ * the bodies), with that set's touches in *t (*n of them) and its pairs' margins in *margin, valid
+ * until the next lc_kept_touches_next_step; else 0. */
 int lc_kept_touches_still(const lc_kept_touches *k, const lc_world *w, const lc_island *isl, double dt,
                           const lc_touch **t, int *n, const double **margin);
 

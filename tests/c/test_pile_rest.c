@@ -18,7 +18,9 @@
  *  (4) the pile of (1) once still (kept_touches.h: it rested through a step at one state): its islands
  *      are not solved (no sweep in a step) and report the same resting contacts with the same forces
  *      step after step; a snapshot of it loads into a world that goes on bit for bit, still unsolved.
- *  (5) the same pile with one more box, sliding along a frictionless shelf 9 m up from the start and
+ *  (5) the still pile of (4) under gravity turned 20 degrees (a setting, no body touched): solved in the
+ *      next step, and it moves.
+ *  (6) the same pile with one more box, sliding along a frictionless shelf 9 m up from the start and
  *      falling off its end onto the pile after the pile is still (at ~15 s, ~11 m/s): nothing but the
  *      impact reaches the pile, no API call. Asserted: the impact wakes it (its bodies move and its
  *      islands are solved again), with LC_OK, no overlap above 1e-6 m and no step gaining more than
@@ -251,6 +253,36 @@ static void still_pile_is_not_solved(void)
     lc_world_destroy(w);
 }
 
+/* A setting changes the problem without touching a body: gravity turned 20 degrees off the vertical
+ * makes the still pile lean on its walls and friction, and it is solved again in the next step. */
+static void setting_wakes_still_pile(void)
+{
+    lc_body_id ids[PILE_BOXES];
+    lc_world *w = pile_scene(ids, 0);
+    lc_counters last;
+    lc_vec2 g;
+    double before[PILE_BOXES * 6], now[PILE_BOXES * 6];
+    int i, moved = 0;
+    if (!w) return;
+    CHECK(sc_step_n(w, 1.0 / 60.0, 900) == 900, "%s", "the pile's 15 s");
+    lc_world_get_counters(w, &last, NULL);
+    CHECK(last.contact_sweeps == 0 && last.contact_rests > 0, "the pile was still after 15 s (%llu sweeps)",
+          (unsigned long long)last.contact_sweeps);
+    pile_state(w, ids, PILE_BOXES, before);
+    g.x = 9.81 * sin(20.0 * SC_PI / 180.0);
+    g.y = -9.81 * cos(20.0 * SC_PI / 180.0);
+    CHECK(lc_world_set_gravity(w, g) == LC_OK, "%s", "gravity turned");
+    CHECK(sc_step_n(w, 1.0 / 60.0, 1) == 1, "%s", "a step under the turned gravity");
+    lc_world_get_counters(w, &last, NULL);
+    CHECK(last.contact_sweeps > 0, "the pile was solved again in the step after the setting (%llu sweeps)",
+          (unsigned long long)last.contact_sweeps);
+    CHECK(sc_step_n(w, 1.0 / 60.0, 59) == 59, "%s", "a second under the turned gravity");
+    pile_state(w, ids, PILE_BOXES, now);
+    for (i = 0; i < PILE_BOXES * 6; ++i) moved += now[i] != before[i];
+    CHECK(moved > 0, "the pile moved under the turned gravity (%d numbers changed)", moved);
+    lc_world_destroy(w);
+}
+
 static void impact_wakes_still_pile(void)
 {
     lc_body_id ids[PILE_BOXES + 1];
@@ -295,6 +327,7 @@ int main(void)
     driven_row_is_never_held();
     undriven_row_stays();
     still_pile_is_not_solved();
+    setting_wakes_still_pile();
     impact_wakes_still_pile();
     return CHECK_SUMMARY("test_pile_rest");
 }
