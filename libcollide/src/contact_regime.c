@@ -567,15 +567,11 @@ static int hold_still(lc_contact_island *c, const lc_touch *kept, int n, const d
     lc_world *w = c->w;
     int i;
     for (i = 0; i < n; ++i) {
-        lc_touch x = kept[i];
-        double fn, ft;
-        if (!(x.gap < w->def.contact_distance)) continue;
-        lc_contact_cache_find(c->cr->cache, key_of(w, &x), &fn, &ft);
-        x.value = fn;
-        x.tangent = ft;
-        if (x.elasticity < 1.0) w->rests_dissipative[x.a] = w->rests_dissipative[x.b] = 1;
-        if (lc_push_contact(w, &x, LC_CONTACT_RESTING) != 0) return -1;
-        if (lc_contact_cache_store(c->cr->cache, key_of(w, &x), fn, ft) != 0) return -1;
+        const lc_touch *x = &kept[i];
+        if (!(x->gap < w->def.contact_distance)) continue;
+        if (x->elasticity < 1.0) w->rests_dissipative[x->a] = w->rests_dissipative[x->b] = 1;
+        if (lc_push_contact(w, x, LC_CONTACT_RESTING) != 0) return -1;
+        if (lc_contact_cache_store(c->cr->cache, key_of(w, x), x->value, x->tangent) != 0) return -1;
         w->last.resting_contacts++;
     }
     w->last.contact_rests++;

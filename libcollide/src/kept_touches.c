@@ -110,12 +110,14 @@ int lc_kept_touches_store(lc_kept_touches *k, const lc_world *w, const lc_island
     if (n > 0) memcpy(tt, t, (size_t)n * sizeof(lc_touch));
     for (i = 0; i < n; ++i) {
         /* the next step's start: velocities as the step left them (the energy guard may have scaled
-         * them after the search), no force or impulse yet */
+         * them after the search), no impulse yet; a still set keeps the forces its resting contacts
+         * were reported with (lc_kept_touches_still), which take() does not pass on */
         const double *sa = &w->state[tt[i].a * 6], *sb = &w->state[tt[i].b * 6];
         lc_vec2 va = lc_add(lc_v(sa[SVX], sa[SVY]), lc_wcross(sa[SW], tt[i].ra));
         lc_vec2 vb = lc_add(lc_v(sb[SVX], sb[SVY]), lc_wcross(sb[SW], tt[i].rb));
         tt[i].vn = lc_dot(tt[i].n, lc_sub(va, vb));
-        tt[i].value = tt[i].tangent = tt[i].vn_pre = tt[i].target_vn = 0.0;
+        if (!still) tt[i].value = tt[i].tangent = 0.0;
+        tt[i].vn_pre = tt[i].target_vn = 0.0;
     }
     for (i = 0; i < isl->nrows; ++i) memcpy(&st[x->nstates + (size_t)i * 6], &w->state[isl->rows[i] * 6], 6 * sizeof(double));
     memcpy(&in[x->nints], isl->rows, (size_t)isl->nrows * sizeof(int));
@@ -193,7 +195,11 @@ int lc_kept_touches_take(const lc_kept_touches *k, const lc_world *w, const lc_i
                 b = t[i].b;
                 m = want(ctx, a, b);
             }
-            if (t[i].gap < m) out[n++] = t[i];
+            if (t[i].gap < m) {
+                out[n] = t[i];
+                out[n].value = out[n].tangent = 0.0;
+                n++;
+            }
         }
     }
     return n;

@@ -27,7 +27,8 @@ void lc_kept_touches_clear(lc_kept_touches *k);
 /* Keeps touches t[0..n), found at w->state (the island's end state) for an island step of dt, the search
  * of pair k of isl having taken every point within margin[k] (m). Their normal velocities are recomputed
  * at that state. still: the island rested through that step at one state (it began and ended it at
- * w->state with every velocity 0: contact_regime.c, "Rest"). 0, or -1 without memory. */
+ * w->state with every velocity 0: contact_regime.c, "Rest"); a still set keeps the touches' value and
+ * tangent (the forces their contacts were reported with), another drops them. 0, or -1 without memory. */
 int lc_kept_touches_store(lc_kept_touches *k, const lc_world *w, const lc_island *isl, double dt, const lc_touch *t,
                           int n, const double *margin, int still);
 /* The touches kept for island isl if it starts a step of dt from the state they were kept at, and if for
@@ -38,8 +39,8 @@ int lc_kept_touches_take(const lc_kept_touches *k, const lc_world *w, const lc_i
                          double (*want)(const void *ctx, int a, int b), const void *ctx, lc_buf *buf);
 /* 1 if island isl starts a step of dt from the state a still set was kept at (as for take) and no API
  * call at all changed the world since (w->api_changes: a setting changes the problem without changing
- * the bodies), with that set's touches in *t (*n of them) and its pairs' margins in *margin, valid
- * until the next lc_kept_touches_next_step; else 0. */
+ * the bodies), with that set's touches (their forces in value and tangent) in *t (*n of them) and its
+ * pairs' margins in *margin, valid until the next lc_kept_touches_next_step; else 0. */
 int lc_kept_touches_still(const lc_kept_touches *k, const lc_world *w, const lc_island *isl, double dt,
                           const lc_touch **t, int *n, const double **margin);
 
