@@ -557,6 +557,19 @@ static void hold_at_rest(lc_contact_island *c)
     c->rested = 1;
 }
 
+/* A touch at the end of an island's step (gap within contact_distance) with its forces in value and
+ * tangent: reported as a resting contact, kept as the next step's warm start, counted, and its bodies
+ * marked when the pair is dissipative (finish and hold_still). 0, or -1 without memory. */
+static int report_resting(lc_contact_island *c, const lc_touch *x)
+{
+    lc_world *w = c->w;
+    if (x->elasticity < 1.0) w->rests_dissipative[x->a] = w->rests_dissipative[x->b] = 1;
+    if (lc_push_contact(w, x, LC_CONTACT_RESTING) != 0) return -1;
+    if (lc_contact_cache_store(c->cr->cache, key_of(w, x), x->value, x->tangent) != 0) return -1;
+    w->last.resting_contacts++;
+    return 0;
+}
+
 /* A still island (kept_touches.h): it rested through its last step at the state it starts this one from,
  * nothing drives it and nothing changed since (no API change, the same rows, pairs and dt). This step's
  * solve would meet the problem it met then and hold the island at rest again, with the state unchanged,
@@ -566,14 +579,8 @@ static int hold_still(lc_contact_island *c, const lc_touch *kept, int n, const d
 {
     lc_world *w = c->w;
     int i;
-    for (i = 0; i < n; ++i) {
-        const lc_touch *x = &kept[i];
-        if (!(x->gap < w->def.contact_distance)) continue;
-        if (x->elasticity < 1.0) w->rests_dissipative[x->a] = w->rests_dissipative[x->b] = 1;
-        if (lc_push_contact(w, x, LC_CONTACT_RESTING) != 0) return -1;
-        if (lc_contact_cache_store(c->cr->cache, key_of(w, x), x->value, x->tangent) != 0) return -1;
-        w->last.resting_contacts++;
-    }
+    for (i = 0; i < n; ++i)
+        if (kept[i].gap < w->def.contact_distance && report_resting(c, &kept[i]) != 0) return -1;
     w->last.contact_rests++;
     return lc_kept_touches_store(c->cr->kept, w, c->isl, c->dt, kept, n, margin, 1);
 }
@@ -655,12 +662,8 @@ static int finish(lc_contact_island *c, lc_touch *end, int nend, const lc_touch 
         }
         x->value = fn;
         x->tangent = ft;
-        if (x->elasticity < 1.0) w->rests_dissipative[x->a] = w->rests_dissipative[x->b] = 1;
-        if (lc_push_contact(w, x, LC_CONTACT_RESTING) != 0) return -1;
-        if (lc_contact_cache_store(c->cr->cache, key_of(w, x), fn, ft) != 0) return -1;
+        if (report_resting(c, x) != 0) return -1;
     }
-    for (i = 0; i < nend; ++i)
-        if (end[i].gap < w->def.contact_distance) w->last.resting_contacts++;
     return 0;
 }
 
