@@ -29,6 +29,8 @@ typedef struct lc_contact_island {
     int precise;         /* solves run to convergence (LC_CONTACT_PRECISE_SWEEPS, _EXACT_POINTS) */
     int settle;          /* this sub-step is a settling one (LC_CONTACT_SETTLE_SPEED) */
     int rested;          /* the last advance() held the island at rest (LC_CONTACT_REST_SPEED) */
+    int hold;            /* the last try of a step no other could take: the island, at rest when the step
+                            began, is held at rest whatever its solves' answer (lc_contact_advance) */
     double max_h;        /* s, the longest sub-step (0: the whole step, cut only at transitions) */
     double slack;        /* m, the projection's stop and trigger (LC_CONTACT_PROJECTION_SLACK or _LARGE_SLACK) */
     double start_h;      /* lc_contact_island_start_margin's h */

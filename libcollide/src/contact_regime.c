@@ -197,10 +197,13 @@ static int applied(lc_contact_island *c)
 }
 
 static void count_solve(lc_contact_island *c, lc_contact_solve s, int rows);
+static double rms_speed(const lc_contact_island *c);
 
 /* Solves rows[0..m) from the velocities in b.v (their start) into b.v: Gauss-Seidel with momentum from
  * the rows' warm start (contact_solver.c), at most contact_iterations sweeps (scaled up for fewer than
- * LC_CONTACT_SMALL_POINTS points), to contact_tolerance; in a settling sub-step by the settling rule
+ * LC_CONTACT_SMALL_POINTS points), to contact_tolerance; in an island of LC_CONTACT_PILE_BODIES to
+ * LC_CONTACT_LARGE_ISLAND_BODIES bodies on from there until the largest change is a fraction of the
+ * island's motion (LC_CONTACT_PILE_FLOW_FRACTION); in a settling sub-step by the settling rule
  * (tunables.h, LC_CONTACT_SETTLE_SPEED). In a
  * precise retry (lc_contact_advance) a problem of at most LC_CONTACT_PRECISE_EXACT_POINTS points is
  * solved exactly (contact_exact.c: active sets, else Lemke) and confirmed by sweeps from that answer, a larger one by up to
@@ -215,6 +218,12 @@ static int solve(lc_contact_island *c, lc_contact_row *rows, int m)
     if (!c->precise && m > 0 && m < LC_CONTACT_SMALL_POINTS)
         sweeps = (int)fmin((double)sweeps * LC_CONTACT_SMALL_POINTS / m, (double)LC_CONTACT_PRECISE_SWEEPS);
     stop = lc_contact_stop_rule(sweeps, w->def.contact_tolerance, c->precise ? 0 : LC_CONTACT_STALL_SWEEPS);
+    if (c->isl->nrows >= LC_CONTACT_PILE_BODIES && c->isl->nrows < LC_CONTACT_LARGE_ISLAND_BODIES && !c->settle &&
+        !c->precise) {
+        stop.loose_after = stop.max_sweeps;
+        stop.loose_tolerance = LC_CONTACT_PILE_FLOW_FRACTION * rms_speed(c);
+        if (stop.max_sweeps < LC_CONTACT_PILE_FLOW_SWEEPS) stop.max_sweeps = LC_CONTACT_PILE_FLOW_SWEEPS;
+    }
     if (c->settle) {
         if (stop.max_sweeps < LC_CONTACT_SETTLE_SWEEPS) stop.max_sweeps = LC_CONTACT_SETTLE_SWEEPS;
         stop.tolerance = fmax(stop.tolerance, LC_CONTACT_SETTLE_TOLERANCE);
@@ -523,13 +532,11 @@ static int island_driven(const lc_contact_island *c)
     return 0;
 }
 
-/* Whether a sub-step starting from b.v0 settles (LC_CONTACT_SETTLE_SPEED): the island is large enough
- * and its mass-weighted rms speed is below the speed. A precise retry keeps its own solves. */
-static int settling(const lc_contact_island *c)
+/* The mass-weighted rms speed of the island's centres at the sub-step's start (b.v0). */
+static double rms_speed(const lc_contact_island *c)
 {
     double mass = 0.0, mv2 = 0.0;
     int k;
-    if (c->precise || c->isl->nrows < LC_CONTACT_SETTLE_BODIES) return 0;
     for (k = 0; k < c->b.n; ++k) {
         const double *v = &c->b.v0[k * 3];
         double m;
@@ -538,21 +545,38 @@ static int settling(const lc_contact_island *c)
         mass += m;
         mv2 += m * (v[0] * v[0] + v[1] * v[1]);
     }
-    return mass > 0.0 && mv2 < LC_CONTACT_SETTLE_SPEED * LC_CONTACT_SETTLE_SPEED * mass;
+    return mass > 0.0 ? sqrt(mv2 / mass) : 0.0;
+}
+
+/* Whether a sub-step starting from b.v0 settles (LC_CONTACT_SETTLE_SPEED): the island is large enough
+ * and its mass-weighted rms speed is below the speed. A precise retry keeps its own solves. */
+static int settling(const lc_contact_island *c)
+{
+    if (c->precise || c->isl->nrows < LC_CONTACT_SETTLE_BODIES) return 0;
+    return rms_speed(c) < LC_CONTACT_SETTLE_SPEED;
+}
+
+/* Whether none of the island's bodies' points (centre speed plus |omega| times the body's radius) moves
+ * at `speed` with the velocities v: body k's vx, vy, omega at v[k * stride]. */
+static int below_speed(const lc_contact_island *c, const double *v, int stride, double speed)
+{
+    int k;
+    for (k = 0; k < c->b.n; ++k) {
+        const double *x = &v[k * stride];
+        if (hypot(x[0], x[1]) + fabs(x[2]) * c->w->radius[c->isl->rows[k]] >= speed) return 0;
+    }
+    return 1;
 }
 
 /* Rest (LC_CONTACT_REST_SPEED): after a settling sub-step's solves, an undriven island none of whose
- * bodies' points moves faster than the rest speed keeps still: b.v becomes 0. */
+ * bodies' points moves faster than the rest speed keeps still: b.v becomes 0. In a held try (c->hold)
+ * it keeps still whatever the solves' answer, and b.v0 becomes 0 too, so that no position moves. */
 static void hold_at_rest(lc_contact_island *c)
 {
-    const lc_world *w = c->w;
-    int k;
-    for (k = 0; k < c->b.n; ++k) {
-        const double *v = &c->b.v[k * 3];
-        if (hypot(v[0], v[1]) + fabs(v[2]) * w->radius[c->isl->rows[k]] >= LC_CONTACT_REST_SPEED) return;
-    }
+    if (!c->hold && !below_speed(c, c->b.v, 3, LC_CONTACT_REST_SPEED)) return;
     if (island_driven(c)) return;
     memset(c->b.v, 0, (size_t)c->b.n * 3 * sizeof(double));
+    if (c->hold) memset(c->b.v0, 0, (size_t)c->b.n * 3 * sizeof(double));
     c->w->last.contact_rests++;
     c->rested = 1;
 }
@@ -711,7 +735,7 @@ static int advance(lc_contact_island *c, double dt, double e0, double size0, int
             cuts++;
             w->last.contact_cuts++;
         }
-        if (c->settle) hold_at_rest(c);
+        if (c->settle || c->hold) hold_at_rest(c);
         advance_positions(c, h);
         left = h < left ? left - h : 0.0;
         if (left < 1e-14 * dt) left = 0.0;
@@ -782,6 +806,17 @@ int lc_contact_advance(lc_world *w, lc_contact_regime *cr, const lc_island *isl,
          * sub-steps, whose velocities drift less between solves (tunables.h) */
         undo_try(w, isl, start, ncontacts, nevents);
         c.max_h = dt / LC_CONTACT_SPLIT_SUBSTEPS;
+        status = advance(&c, dt, e0, size0, &nend, &nt, &h);
+    }
+    if (status == -3 && isl->nrows > LC_CONTACT_EVENT_FALLBACK_BODIES && !island_driven(&c) &&
+        below_speed(&c, start + 3, 6, LC_CONTACT_HOLD_SPEED)) {
+        /* an island at rest when the step began that no try could advance without an overlap or a gain
+         * (a pile whose solves end a few 1e-6 m/s off, driving bodies into each other, and whose
+         * projection then lifts them higher than they sank): held at rest, as a settling step holds
+         * one whose answer is below the rest speed; its state stays, so it gains nothing */
+        undo_try(w, isl, start, ncontacts, nevents);
+        c.max_h = 0.0;
+        c.hold = 1;
         status = advance(&c, dt, e0, size0, &nend, &nt, &h);
     }
     if (status == -3 && isl->nrows > LC_CONTACT_EVENT_FALLBACK_BODIES) {

@@ -229,6 +229,8 @@ lc_contact_stop lc_contact_stop_rule(int max_sweeps, double tolerance, int stall
     stop.body_tolerance = 0.0;
     stop.nbodies = 0;
     stop.before = NULL;
+    stop.loose_after = max_sweeps;
+    stop.loose_tolerance = 0.0;
     return stop;
 }
 
@@ -283,6 +285,7 @@ lc_contact_solve lc_contact_solver_run(lc_contact_row *rows, int nrows, double *
         out.sweeps = s + 1;
         out.residual = change;
         if (change <= stop->tolerance || (stop->body_tolerance > 0.0 && bodies_still(stop, v))) break;
+        if (out.sweeps >= stop->loose_after && change <= stop->loose_tolerance) break;
         /* Nonsmooth nonlinear conjugate gradients (Silcowitz, Niebe and Erleben 2010): the sweep's
          * step r = lambda - lambda_prev is a descent direction; adding beta times the last direction,
          * beta = |r|^2 / |r_old|^2 (Fletcher-Reeves, restarted when it exceeds 1), carries a stack's

@@ -24,6 +24,7 @@
  * every row then met its condition to `tolerance` when it was visited. With `body_tolerance`, so does
  * a sweep that changed no body's velocity component by more than it (a pile's impulses are not unique,
  * and Gauss-Seidel can trade them between rows sweep after sweep at velocities that no longer move).
+ * From `loose_after` sweeps on, a sweep whose largest change is at most `loose_tolerance` ends it too.
  * Otherwise the solve ends after `max_sweeps` sweeps, or when that largest change, below
  * `stall_below`, has not halved over `stall_sweeps` sweeps (the iteration crawls; 0: never), and
  * reports it as its residual. A warm start (the impulses passed in) is applied
@@ -63,9 +64,11 @@ typedef struct lc_contact_stop {
     double body_tolerance; /* m/s, 0: off; else `before` holds nbodies x 3 doubles of scratch */
     int nbodies;
     double *before;
+    int loose_after;       /* sweeps after which loose_tolerance ends the solve too */
+    double loose_tolerance;/* m/s, 0: no looser tolerance */
 } lc_contact_stop;
 
-/* The rule of max_sweeps, tolerance and stall_sweeps alone. */
+/* The rule of max_sweeps, tolerance and stall_sweeps alone (no body or loose tolerance). */
 lc_contact_stop lc_contact_stop_rule(int max_sweeps, double tolerance, int stall_sweeps);
 
 typedef struct lc_contact_solve {

@@ -157,6 +157,22 @@
  * 1 000-box pile's projection (active sets and MPRGP) then took +23 % of a step. Fewer bodies than this
  * (a few polygons with many vertices) converge, and keep the exact impacts and the 4e-10 m slack. */
 #define LC_CONTACT_PILE_BODIES 16
+/* A solve of an island of LC_CONTACT_PILE_BODIES to LC_CONTACT_LARGE_ISLAND_BODIES bodies (outside a
+ * settling sub-step or a precise retry) that has not met contact_tolerance in its sweeps goes on until
+ * its largest change (m/s) is at most this fraction of the island's mass-weighted rms speed, for
+ * LC_CONTACT_PILE_FLOW_SWEEPS sweeps in all at most (the stall rule still applies). Cut at 30 sweeps, a
+ * pile moving at centimetres a second keeps an error the size of its motion: its friction holds too
+ * little, boxes slide off one another and the pile flows on, a slow avalanche that kept 100 mixed boxes
+ * at 3-37 cm/s rms from 4 s to 11 s (bench/scenes.py mixed_boxes, seed 5; Box2D v3's pile of that scene
+ * rests by 6 s; tests/python/test_pile_comes_to_rest.py). A falling pile keeps the cheap cut-off: its
+ * error is small beside its motion. Islands of LC_CONTACT_LARGE_ISLAND_BODIES or more keep it too: a
+ * settling 1 000-box pile's sweeps over ~6 000 points then took 1.7x the CPU a step. */
+#ifndef LC_CONTACT_PILE_FLOW_FRACTION   /* -D to measure */
+#define LC_CONTACT_PILE_FLOW_FRACTION 0.1
+#endif
+#ifndef LC_CONTACT_PILE_FLOW_SWEEPS   /* -D to measure */
+#define LC_CONTACT_PILE_FLOW_SWEEPS 100
+#endif
 /* When a contact-regime step ends with an overlap it cannot project away or an energy gain the island's
  * kinetic energy cannot pay (a nearly resting island whose solves stopped at contact_iterations, 1e-4
  * to 5e-3 m/s off), the step is taken again with solves of up to this many sweeps and exact ones up to
@@ -199,6 +215,17 @@
  * force, spring, force callback) is never held. */
 #ifndef LC_CONTACT_REST_SPEED   /* -D to measure */
 #define LC_CONTACT_REST_SPEED 1e-5
+#endif
+/* m/s: an undriven island of more than LC_CONTACT_EVENT_FALLBACK_BODIES bodies none of whose bodies'
+ * points moved this fast when the step began, and whose step no try could take without an overlap or a
+ * gain its kinetic energy could not pay (lc_contact_advance), is held at rest for the step: its
+ * velocities become 0 and its state stays. Such a pile is resting but for its solves' error: they end a
+ * few 1e-6 m/s off, that drives bodies into each other, and the projection lifts them higher than they
+ * sank (a box dropped on a base-17 pyramid: 2.4e-5 J kept, 2.4e-9 of the world's energy, from 1.9e-5 m/s
+ * at most). Held, it loses at most its kinetic energy and a step's travel at this speed (1.7e-6 m at dt
+ * 1/60). */
+#ifndef LC_CONTACT_HOLD_SPEED   /* -D to measure */
+#define LC_CONTACT_HOLD_SPEED 1e-4
 #endif
 /* Pivots the exact solver may take per unknown before it gives up (Lemke's pivoting cycles only on
  * degenerate ties, which the lexicographic rule breaks; the cap is a guard). */
