@@ -202,8 +202,9 @@ static double rms_speed(const lc_contact_island *c);
 /* Solves rows[0..m) from the velocities in b.v (their start) into b.v: Gauss-Seidel with momentum from
  * the rows' warm start (contact_solver.c), at most contact_iterations sweeps (scaled up for fewer than
  * LC_CONTACT_SMALL_POINTS points), to contact_tolerance; in an island of LC_CONTACT_PILE_BODIES to
- * LC_CONTACT_LARGE_ISLAND_BODIES bodies on from there until the largest change is a fraction of the
- * island's motion (LC_CONTACT_PILE_FLOW_FRACTION); in a settling sub-step by the settling rule
+ * LC_CONTACT_LARGE_ISLAND_BODIES bodies moving slower than gravity changes a velocity in a step, on from
+ * there until the largest change is a fraction of its motion (LC_CONTACT_PILE_FLOW_FRACTION); in a
+ * settling sub-step by the settling rule
  * (tunables.h, LC_CONTACT_SETTLE_SPEED). In a
  * precise retry (lc_contact_advance) a problem of at most LC_CONTACT_PRECISE_EXACT_POINTS points is
  * solved exactly (contact_exact.c: active sets, else Lemke) and confirmed by sweeps from that answer, a larger one by up to
@@ -219,7 +220,7 @@ static int solve(lc_contact_island *c, lc_contact_row *rows, int m)
         sweeps = (int)fmin((double)sweeps * LC_CONTACT_SMALL_POINTS / m, (double)LC_CONTACT_PRECISE_SWEEPS);
     stop = lc_contact_stop_rule(sweeps, w->def.contact_tolerance, c->precise ? 0 : LC_CONTACT_STALL_SWEEPS);
     if (c->isl->nrows >= LC_CONTACT_PILE_BODIES && c->isl->nrows < LC_CONTACT_LARGE_ISLAND_BODIES && !c->settle &&
-        !c->precise) {
+        !c->precise && rms_speed(c) < hypot(w->def.gravity.x, w->def.gravity.y) * c->dt) {
         stop.loose_after = stop.max_sweeps;
         stop.loose_tolerance = LC_CONTACT_PILE_FLOW_FRACTION * rms_speed(c);
         if (stop.max_sweeps < LC_CONTACT_PILE_FLOW_SWEEPS) stop.max_sweeps = LC_CONTACT_PILE_FLOW_SWEEPS;
