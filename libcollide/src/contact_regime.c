@@ -199,17 +199,20 @@ static int applied(lc_contact_island *c)
 static void count_solve(lc_contact_island *c, lc_contact_solve s, int rows);
 static double rms_speed(const lc_contact_island *c);
 
+/* Which solve of a sub-step: the impact stage's (step 2) or the flow's (step 3). */
+enum { SOLVE_IMPACT, SOLVE_FLOW };
+
 /* Solves rows[0..m) from the velocities in b.v (their start) into b.v: Gauss-Seidel with momentum from
  * the rows' warm start (contact_solver.c), at most contact_iterations sweeps (scaled up for fewer than
- * LC_CONTACT_SMALL_POINTS points), to contact_tolerance; in an island of LC_CONTACT_PILE_BODIES to
- * LC_CONTACT_LARGE_ISLAND_BODIES bodies moving slower than gravity changes a velocity in a step, on from
- * there until the largest change is a fraction of its motion (LC_CONTACT_PILE_FLOW_FRACTION); in a
- * settling sub-step by the settling rule
+ * LC_CONTACT_SMALL_POINTS points), to contact_tolerance; the flow of an island of LC_CONTACT_PILE_BODIES
+ * bodies or more moving slower than gravity changes a velocity in a step, on from there until the
+ * largest change is a fraction of its motion (LC_CONTACT_PILE_FLOW_FRACTION); in a settling sub-step by
+ * the settling rule
  * (tunables.h, LC_CONTACT_SETTLE_SPEED). In a
  * precise retry (lc_contact_advance) a problem of at most LC_CONTACT_PRECISE_EXACT_POINTS points is
  * solved exactly (contact_exact.c: active sets, else Lemke) and confirmed by sweeps from that answer, a larger one by up to
  * LC_CONTACT_PRECISE_SWEEPS sweeps. Returns 0, or -1 without memory. */
-static int solve(lc_contact_island *c, lc_contact_row *rows, int m)
+static int solve(lc_contact_island *c, lc_contact_row *rows, int m, int which)
 {
     lc_world *w = c->w;
     lc_contact_solve s;
@@ -219,8 +222,8 @@ static int solve(lc_contact_island *c, lc_contact_row *rows, int m)
     if (!c->precise && m > 0 && m < LC_CONTACT_SMALL_POINTS)
         sweeps = (int)fmin((double)sweeps * LC_CONTACT_SMALL_POINTS / m, (double)LC_CONTACT_PRECISE_SWEEPS);
     stop = lc_contact_stop_rule(sweeps, w->def.contact_tolerance, c->precise ? 0 : LC_CONTACT_STALL_SWEEPS);
-    if (c->isl->nrows >= LC_CONTACT_PILE_BODIES && c->isl->nrows < LC_CONTACT_LARGE_ISLAND_BODIES && !c->settle &&
-        !c->precise && rms_speed(c) < hypot(w->def.gravity.x, w->def.gravity.y) * c->dt) {
+    if (which == SOLVE_FLOW && c->isl->nrows >= LC_CONTACT_PILE_BODIES && !c->settle && !c->precise &&
+        rms_speed(c) < hypot(w->def.gravity.x, w->def.gravity.y) * c->dt) {
         stop.loose_after = stop.max_sweeps;
         stop.loose_tolerance = LC_CONTACT_PILE_FLOW_FRACTION * rms_speed(c);
         if (stop.max_sweeps < LC_CONTACT_PILE_FLOW_SWEEPS) stop.max_sweeps = LC_CONTACT_PILE_FLOW_SWEEPS;
@@ -307,7 +310,7 @@ static int impacts(lc_contact_island *c, lc_touch *t, int nt, double h)
     }
     if (!fast) return 0;
     memcpy(c->b.v, c->b.v0, (size_t)c->b.n * 3 * sizeof(double));
-    if (solve(c, rows, m) != 0) return -1;
+    if (solve(c, rows, m, SOLVE_IMPACT) != 0) return -1;
     /* Poisson: e j_c more along the normal where the point's own approach was fast enough to bounce.
      * Those impulses push the bodies into their other touches too (a box hit from above, resting on
      * the floor), whose own e may be 0: a second compression stops every approach they start, as the
@@ -329,7 +332,7 @@ static int impacts(lc_contact_island *c, lc_touch *t, int nt, double h)
     }
     if (bounced) {
         for (i = 0; i < m; ++i) rows[i].lambda_n = rows[i].lambda_t = 0.0;
-        if (solve(c, rows, m) != 0) return -1;
+        if (solve(c, rows, m, SOLVE_IMPACT) != 0) return -1;
         for (i = 0; i < m; ++i) {
             t[which[i]].value += rows[i].lambda_n;
             t[which[i]].tangent += rows[i].lambda_t;
@@ -417,7 +420,7 @@ static int flow(lc_contact_island *c, const lc_touch *t, int nt, double h, lc_co
         }
     }
     if (cold_start(c, t, nt, h, known, rows) != 0) return -1;
-    return solve(c, rows, nt);
+    return solve(c, rows, nt, SOLVE_FLOW);
 }
 
 /* The collisions of a pile sub-step: its impact points that approached faster than resting_speed and

@@ -157,19 +157,20 @@
  * 1 000-box pile's projection (active sets and MPRGP) then took +23 % of a step. Fewer bodies than this
  * (a few polygons with many vertices) converge, and keep the exact impacts and the 4e-10 m slack. */
 #define LC_CONTACT_PILE_BODIES 16
-/* A solve of an island of LC_CONTACT_PILE_BODIES to LC_CONTACT_LARGE_ISLAND_BODIES bodies (outside a
- * settling sub-step or a precise retry) whose mass-weighted rms speed is below |g| dt (16 cm/s at dt
- * 1/60), and that has not met contact_tolerance in its sweeps, goes on until its largest change (m/s) is
- * at most this fraction of that speed, for LC_CONTACT_PILE_FLOW_SWEEPS sweeps in all at most (the stall
- * rule still applies). Such a pile moves slower than gravity changes a velocity in one step: its contacts
+/* The flow's solve (step 3) of an island of LC_CONTACT_PILE_BODIES bodies or more (outside a settling
+ * sub-step or a precise retry) whose mass-weighted rms speed is below |g| dt (16 cm/s at dt 1/60), and
+ * that has not met contact_tolerance in its sweeps, goes on until its largest change (m/s) is at most
+ * this fraction of that speed, for LC_CONTACT_PILE_FLOW_SWEEPS sweeps in all at most (the stall rule
+ * still applies). Such a pile moves slower than gravity changes a velocity in one step: its contacts
  * carry most of its weight every step, and cut at 30 sweeps their impulses keep an error the size of its
  * motion. Its friction then holds too little, boxes slide off one another and the pile flows on, a slow
- * avalanche that kept 100 mixed boxes at 3-37 cm/s rms from 4 s to 11 s (bench/scenes.py mixed_boxes,
- * seed 5; Box2D v3's pile of that scene rests by 6 s; tests/python/test_pile_comes_to_rest.py). A
- * falling pile keeps the cheap cut-off: its error is small beside its motion. So does a pile at small
- * steps (the node's 1 ms: below 1 cm/s it settles), where going on cost more and the 200-box piles of
- * bench/node_bench.py came to rest 0.5-0.75 s later; and an island of LC_CONTACT_LARGE_ISLAND_BODIES or
- * more, where a settling 1 000-box pile's sweeps over ~6 000 points took 1.7x the CPU a step. */
+ * avalanche: 100 mixed boxes at 3-37 cm/s rms from 4 s to 11 s (bench/scenes.py mixed_boxes, seed 5;
+ * Box2D v3's pile of that scene rests by 6 s; tests/python/test_pile_comes_to_rest.py), 1 000 boxes
+ * moving 0.2-0.5 m in every second up to 12 s (seed 2). A falling pile keeps the cheap cut-off: its error
+ * is small beside its motion. So does a pile at small steps (the node's 1 ms: below 1 cm/s it settles),
+ * where going on cost more and the 200-box piles of bench/node_bench.py came to rest 0.5-0.75 s later;
+ * and the impact stage's solves, which stop approaches rather than hold weight (going on there too cost
+ * a settling 1 000-box pile up to 115 ms a step, against 60-90 ms). */
 #ifndef LC_CONTACT_PILE_FLOW_FRACTION   /* -D to measure */
 #define LC_CONTACT_PILE_FLOW_FRACTION 0.1
 #endif
