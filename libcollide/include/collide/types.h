@@ -284,7 +284,8 @@ typedef struct lc_counters {
     uint64_t energy_clamps;           /* contact-regime island steps whose energy gain was taken back from
                                          the island's kinetic energy */
     uint64_t contact_rests;           /* contact-regime island sub-steps held at rest (a settling pile whose
-                                         answer moved no point faster than the rest speed, 1e-5 m/s), and
+                                         answer moved no point faster than the rest speed, 1e-5 m/s, or a
+                                         step no try could take of an island at rest to 1e-4 m/s), and
                                          steps of still islands, not solved */
     uint64_t contact_unresolved;      /* contact-regime steps of islands too large for the event regime kept
                                          with an overlap or an energy gain above the engine's allowance
