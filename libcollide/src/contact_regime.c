@@ -222,11 +222,13 @@ static int solve(lc_contact_island *c, lc_contact_row *rows, int m, int which)
     if (!c->precise && m > 0 && m < LC_CONTACT_SMALL_POINTS)
         sweeps = (int)fmin((double)sweeps * LC_CONTACT_SMALL_POINTS / m, (double)LC_CONTACT_PRECISE_SWEEPS);
     stop = lc_contact_stop_rule(sweeps, w->def.contact_tolerance, c->precise ? 0 : LC_CONTACT_STALL_SWEEPS);
-    if (which == SOLVE_FLOW && c->isl->nrows >= LC_CONTACT_PILE_BODIES && !c->settle && !c->precise &&
-        rms_speed(c) < hypot(w->def.gravity.x, w->def.gravity.y) * c->dt) {
-        stop.loose_after = stop.max_sweeps;
-        stop.loose_tolerance = LC_CONTACT_PILE_FLOW_FRACTION * rms_speed(c);
-        if (stop.max_sweeps < LC_CONTACT_PILE_FLOW_SWEEPS) stop.max_sweeps = LC_CONTACT_PILE_FLOW_SWEEPS;
+    if (which == SOLVE_FLOW && c->isl->nrows >= LC_CONTACT_PILE_BODIES && !c->settle && !c->precise) {
+        double rms = rms_speed(c);
+        if (rms < hypot(w->def.gravity.x, w->def.gravity.y) * c->dt) {
+            stop.loose_after = stop.max_sweeps;
+            stop.loose_tolerance = LC_CONTACT_PILE_FLOW_FRACTION * rms;
+            if (stop.max_sweeps < LC_CONTACT_PILE_FLOW_SWEEPS) stop.max_sweeps = LC_CONTACT_PILE_FLOW_SWEEPS;
+        }
     }
     if (c->settle) {
         if (stop.max_sweeps < LC_CONTACT_SETTLE_SWEEPS) stop.max_sweeps = LC_CONTACT_SETTLE_SWEEPS;

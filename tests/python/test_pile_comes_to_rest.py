@@ -1,16 +1,15 @@
-"""A dropped pile whose flow solves are cut at contact_iterations still comes to rest.
+"""A dropped pile comes to rest: the contact bench's 100-box mixed pile of seed 5 (bench/scenes.py
+mixed_boxes: boxes 0.3-0.8 m, mu 0.5, e 0.3, dropped into a walled box, dt 1/60).
 
-The contact bench's 100-box mixed pile of seed 5 (bench/scenes.py mixed_boxes: boxes 0.3-0.8 m, mu 0.5,
-e 0.3, dropped into a walled box, dt 1/60) is the case: with its pile sub-steps' flows cut at 30 sweeps
-whatever their error, the pile never settled. Its solves left an error the size of its motion at a few
-centimetres a second, its friction held too little, and it kept flowing at 3-28 cm/s rms from 4 s to
-12 s, where Box2D v3's pile of the same scene rests by 6 s (bench/repro/pile_rest.py). A pile sub-step's
-flow now goes on until its error is a tenth of the pile's motion (tunables.h,
-LC_CONTACT_PILE_FLOW_FRACTION).
+This pile is the case for the pile rule (docs/contact_regime.md, stopping rule; tunables.h
+LC_CONTACT_PILE_FLOW_FRACTION): moving at centimetres a second, slower than gravity changes a velocity in
+a step, its flow solves stopped at contact_iterations sweeps keep an error the size of its motion, its
+friction holds too little and it flows on as a slow avalanche (3-37 cm/s rms up to 11 s). Box2D v3's pile
+of the same scene rests by 6 s (bench/repro/pile_rest.py).
 
-Asserted over 12 s: every step returns LC_OK, no step gains more than 1e-9 of the total energy (nothing
-drives the scene), and the pile rests: over the last 2 s every body's velocity is exactly 0 and no
-coordinate changes by a single bit (docs/contact_regime.md, "Settling and rest")."""
+Asserted over 12 s: no step gains more than 1e-9 of the total energy (nothing drives the scene), and the
+pile rests: over the last 2 s every body's velocity is exactly 0 and no coordinate changes by a single
+bit (docs/contact_regime.md, "Settling and rest")."""
 from __future__ import annotations
 
 import numpy as np
