@@ -26,7 +26,8 @@
  *      sub-step of several bodies and fewer than LC_CONTACT_MOREAU_JEAN_POINTS points, and in a pile
  *      sub-step;
  *   6. a projection moves overlapping points out by the smallest mass-weighted displacement (a large
- *      pass starting from active sets over a sparse factorization: contact_projection.c), and an
+ *      pass starting from active sets over a sparse factorization; in a pile sub-step first over the
+ *      flow's points, then over a search: contact_projection.c), and an
  *      island without driving forces that still ends with more energy than it began with gives the
  *      excess back from its kinetic energy. An island this cannot keep apart, or whose kinetic energy
  *      cannot pay, is taken again by the event regime (step.c). */
@@ -64,7 +65,7 @@ struct lc_contact_regime {
     lc_buf b_vstart;     /* start velocities of an exact solve */
     lc_buf b_known;      /* per flow row: 1 if the last step kept a force for its point (even 0) */
     lc_buf b_margin;     /* per island pair: the margin of the last end-of-step search */
-    lc_buf b_sweep_v;    /* a settling solve's velocities before each sweep */
+    lc_buf b_sweep;      /* the solver's scratch (lc_contact_solver_run) */
 };
 
 lc_contact_regime *lc_contact_regime_create(void)
@@ -105,7 +106,7 @@ void lc_contact_regime_destroy(lc_contact_regime *cr)
     lc_buf_free(&cr->b_vstart);
     lc_buf_free(&cr->b_known);
     lc_buf_free(&cr->b_margin);
-    lc_buf_free(&cr->b_sweep_v);
+    lc_buf_free(&cr->b_sweep);
     free(cr);
 }
 
@@ -216,6 +217,7 @@ static int solve(lc_contact_island *c, lc_contact_row *rows, int m, int which)
 {
     lc_world *w = c->w;
     lc_contact_solve s;
+    double *scratch;
     int sweeps = c->precise && w->def.contact_iterations < LC_CONTACT_PRECISE_SWEEPS ? LC_CONTACT_PRECISE_SWEEPS
                                                                                      : w->def.contact_iterations;
     lc_contact_stop stop;
@@ -235,9 +237,6 @@ static int solve(lc_contact_island *c, lc_contact_row *rows, int m, int which)
         stop.tolerance = fmax(stop.tolerance, LC_CONTACT_SETTLE_TOLERANCE);
         stop.stall_below = LC_CONTACT_REST_SPEED;
         stop.body_tolerance = LC_CONTACT_SETTLE_BODY_TOLERANCE;
-        stop.nbodies = c->b.n;
-        stop.before = lc_buf_get(&c->cr->b_sweep_v, (size_t)(c->b.n > 0 ? c->b.n : 1) * 3 * sizeof(double));
-        if (stop.before == NULL) return -1;
     }
     if (c->precise && m > 0 && m <= LC_CONTACT_PRECISE_EXACT_POINTS) {
         size_t nv = (size_t)c->b.n * 3;
@@ -256,7 +255,9 @@ static int solve(lc_contact_island *c, lc_contact_row *rows, int m, int which)
     }
     /* a precise retry runs its sweeps out: a perturbed pyramid's solve crawls, below the stall rule's
      * halving, to an answer whose energy the island can pay, where stopping left a gain */
-    s = lc_contact_solver_run(rows, m, c->b.v, c->b.inv_mass, c->b.inv_inertia, &stop);
+    scratch = lc_buf_get(&c->cr->b_sweep, (size_t)(c->b.n > 0 ? c->b.n : 1) * 6 * sizeof(double));
+    if (scratch == NULL) return -1;
+    s = lc_contact_solver_run(rows, m, c->b.n, c->b.v, c->b.inv_mass, c->b.inv_inertia, &stop, scratch);
     count_solve(c, s, m);
     return 0;
 }
@@ -748,7 +749,8 @@ static int advance(lc_contact_island *c, double dt, double e0, double size0, int
     }
     *h_last = h;
     /* the touches at the end: projection, results, warm start */
-    *nend = lc_contact_project(cr->projection, c, &cr->b_end, &cr->b_margin, &overlap);
+    *nend = lc_contact_project(cr->projection, c, (const lc_touch *)cr->b_touch.p, *nt, &cr->b_end, &cr->b_margin,
+                               &overlap);
     if (*nend < 0) return -1;
     /* bodies the projection cannot separate (wedged deep into a corner within one step), or an energy
      * gain the island's kinetic energy cannot pay for */

@@ -61,9 +61,7 @@ typedef struct lc_contact_stop {
     double tolerance;      /* m/s */
     int stall_sweeps;      /* 0: no stall rule */
     double stall_below;    /* m/s, the largest change below which the stall rule applies (INFINITY: always) */
-    double body_tolerance; /* m/s, 0: off; else `before` holds nbodies x 3 doubles of scratch */
-    int nbodies;
-    double *before;
+    double body_tolerance; /* m/s, 0: off */
     int loose_after;       /* sweeps after which loose_tolerance ends the solve too */
     double loose_tolerance;/* m/s, 0: no looser tolerance */
 } lc_contact_stop;
@@ -77,9 +75,10 @@ typedef struct lc_contact_solve {
 } lc_contact_solve;
 
 /* Solves the rows in place. v: nbodies x 3 velocities (changed in place: the answer's velocities);
- * inv_mass, inv_inertia: nbodies each. Rows with a non-finite warm start start from 0. */
-lc_contact_solve lc_contact_solver_run(lc_contact_row *rows, int nrows, double *v, const double *inv_mass,
-                                       const double *inv_inertia, const lc_contact_stop *stop);
+ * inv_mass, inv_inertia: nbodies each; scratch: nbodies x 6 doubles. Rows with a non-finite warm start
+ * start from 0. */
+lc_contact_solve lc_contact_solver_run(lc_contact_row *rows, int nrows, int nbodies, double *v, const double *inv_mass,
+                                       const double *inv_inertia, const lc_contact_stop *stop, double *scratch);
 
 /* Adds the impulse dn along the row's normal and dt along its tangent to its two bodies' velocities v. */
 void lc_contact_row_apply(const lc_contact_row *r, double dn, double dt, double *v, const double *inv_mass,

@@ -62,6 +62,35 @@ void lc_touch_update(const lc_world *w, const double *state, lc_touch *t)
     touch_update(w, state, frame_of(w, state, t->a), frame_of(w, state, t->b), t);
 }
 
+int lc_touch_refresh(const lc_world *w, const double *state, lc_touch *t, double extent)
+{
+    frame fa = frame_of(w, state, t->a), fb = frame_of(w, state, t->b);
+    const lc_shape *sb = &w->shape[t->b];
+    lc_vec2 local = to_local(fb, to_world(fa, w->shape[t->a].v[t->vertex]));
+    double len, u, grow, deepest = -INFINITY;
+    int k, least = t->edge;
+    for (k = 0; k < sb->count; ++k) {
+        double d = edge_distance(sb, k, local);
+        if (d > deepest) {
+            deepest = d;
+            least = k;
+        }
+    }
+    if (deepest < 0.0) {
+        /* inside b: the edge it is least deep behind, as the vertex-in-body test finds it */
+        t->edge = least;
+        touch_update(w, state, fa, fb, t);
+        return 1;
+    }
+    touch_update(w, state, fa, fb, t);
+    /* outside b but behind its edge's line: beside the edge, not in it */
+    if (t->gap < 0.0) return 0;
+    /* as face_touches keeps a vertex: over the edge, the edge grown by extent for one within extent */
+    u = edge_param(sb, t->edge, local, &len);
+    grow = t->gap < extent ? extent : 0.0;
+    return !(u * len < -grow || (u - 1.0) * len > grow);
+}
+
 static double mix(lc_mix_rule r, double x, double y)
 {
     switch (r) {

@@ -280,6 +280,11 @@ lc_status lc_force_callback_potential(const lc_world *w, const double *state, do
 /* ---- narrow_phase.c ---- */
 /* Geometry of a vertex/edge touch at `state`; fills p, n, ra, rb, gap, vn. */
 void lc_touch_update(const lc_world *w, const double *state, lc_touch *t);
+/* The touch at `state` (lc_touch_update) if its vertex is a contact there: 1 if the vertex is inside body b
+ * (the touch then takes the edge the vertex is least deep behind), or outside and over its edge (grown
+ * by extent at each end for a vertex within extent of its line), as lc_collect_touches_within keeps a
+ * point; 0 if outside and not over it, or behind its line beside the body. */
+int lc_touch_refresh(const lc_world *w, const double *state, lc_touch *t, double extent);
 /* Appends touches between rows a and b with gap < max_gap (both directions), reduced to a manifold.
  * Returns the new count or -1 on allocation failure. */
 int lc_collect_touches(const lc_world *w, const double *state, int a, int b, double max_gap,

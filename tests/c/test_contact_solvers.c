@@ -26,12 +26,14 @@
 #include "contact_exact.h"
 #include "contact_solver.h"
 
-/* lc_contact_solver_run under the stop rule of max_sweeps, tolerance and stall_sweeps. */
-static lc_contact_solve run_solver(lc_contact_row *rows, int n, double *v, const double *im, const double *ii,
+/* lc_contact_solver_run over nb bodies (at most 3) under the stop rule of max_sweeps, tolerance and
+ * stall_sweeps. */
+static lc_contact_solve run_solver(lc_contact_row *rows, int n, int nb, double *v, const double *im, const double *ii,
                                    int max_sweeps, double tolerance, int stall_sweeps)
 {
     lc_contact_stop stop = lc_contact_stop_rule(max_sweeps, tolerance, stall_sweeps);
-    return lc_contact_solver_run(rows, n, v, im, ii, &stop);
+    double scratch[3 * 6];
+    return lc_contact_solver_run(rows, n, nb, v, im, ii, &stop, scratch);
 }
 
 #define G 9.81
@@ -94,7 +96,7 @@ static void ramp(double mu, int solver)
         int rounds = lc_contact_solve_active_set(r, 2, v, im, ii, scratch);
         CHECK(rounds >= 1, "%s mu %.1f: the states settle from none (%d rounds)", who, mu, rounds);
     } else {
-        lc_contact_solve s = run_solver(r, 2, v, im, ii, 10000, 1e-12, 32);
+        lc_contact_solve s = run_solver(r, 2, 1, v, im, ii, 10000, 1e-12, 32);
         CHECK(s.residual <= 1e-12, "%s mu %.1f: converges (%d sweeps, residual %.3g)", who, mu, s.sweeps,
               s.residual);
     }
@@ -132,7 +134,7 @@ static void two_blocks(void)
     /* the exact impulses as a warm start from the start velocities: one sweep changes them by no more
      * than their 1e-9 m/s */
     memcpy(again, r, sizeof r);
-    s = run_solver(again, 4, v1, im, ii, 100, 1e-9, 32);
+    s = run_solver(again, 4, 2, v1, im, ii, 100, 1e-9, 32);
     CHECK(s.sweeps == 1 && s.residual <= 1e-9, "the exact answer is the iteration's fixed point (%d sweeps, %.3g)",
           s.sweeps, s.residual);
 }
@@ -185,14 +187,14 @@ static void random_stacks(void)
          * a larger regularization and its answer is ~1e-7 m/s off (the sweeps after it take that) */
         memcpy(again, lemke_rows, sizeof r);
         memcpy(vp, v0, sizeof v0);
-        if (run_solver(again, 6, vp, im, ii, 1, 0.0, 0).residual <= 1e-9) {
+        if (run_solver(again, 6, 3, vp, im, ii, 1, 0.0, 0).residual <= 1e-9) {
             compared++;
             for (i = 0; i < 9; ++i) d = fmax(d, fabs(v[i] - vl[i]));
             worst = fmax(worst, d);
         }
         memcpy(again, r, sizeof r);
         memcpy(vp, v0, sizeof v0);
-        s = run_solver(again, 6, vp, im, ii, 1, 0.0, 0);
+        s = run_solver(again, 6, 3, vp, im, ii, 1, 0.0, 0);
         worst_fixed = fmax(worst_fixed, s.residual);
         /* from the answer with every impulse off by up to 30 %: the states are found again */
         for (i = 0; i < 6; ++i) {

@@ -156,7 +156,7 @@ static void stream_matches_polling(lc_world *w, double dt, int n, int every, int
 /* 1 kHz steps read at 100 Hz (the node's rates): no impact lost or repeated, in each regime. */
 static void no_impact_lost(void)
 {
-    int kinds[2] = {0, 0}, pile[2] = {0, 0};
+    int kinds[2] = {0, 0}, pile[2] = {0, 0}, base;
     lc_world *w = seed_scene(4096);
     lc_counters total;
     if (w) {
@@ -170,16 +170,18 @@ static void no_impact_lost(void)
         lc_world_destroy(w);
     }
     /* island steps solved again: the first solve's impacts must not be reported twice. A box dropped on
-     * a base-10 pyramid (tests/c/test_drop_family.c) leaves, at two of its steps, an overlap or a gain
-     * the precise retry removes */
-    w = sc_drop_on_pyramid(10);
-    if (w) {
+     * a pyramid (tests/c/test_drop_family.c) leaves, at a few steps of some bases, an overlap or a gain
+     * the precise retry removes: the first base from 8 up whose drop has them */
+    total.contact_precise_retries = 0;
+    for (base = 8; base <= 16 && total.contact_precise_retries == 0; ++base) {
+        w = sc_drop_on_pyramid(base);
+        if (w == NULL) break;
         stream_matches_polling(w, 1.0 / 60.0, 300, 10, pile, "pile solved again", 20);
         lc_world_get_counters(w, NULL, &total);
-        CHECK(total.contact_precise_retries > 0, "the pile's island steps were solved again (%llu)",
-              (unsigned long long)total.contact_precise_retries);
         lc_world_destroy(w);
     }
+    CHECK(total.contact_precise_retries > 0, "a pile's island steps were solved again (%llu, bases 8-%d)",
+          (unsigned long long)total.contact_precise_retries, base - 1);
     CHECK(pile[LC_IMPACT_CONTACT] > 0, "the pile reports contact-regime impacts (%d)", pile[LC_IMPACT_CONTACT]);
     /* a step taken again: the first try's impacts must not be reported twice */
     w = chain_scene();

@@ -304,6 +304,7 @@ static int sweeps_from(const problem *p, const double *b, const double *lambda, 
 {
     lc_contact_row *gs = calloc((size_t)p->m, sizeof(lc_contact_row));
     lc_contact_stop stop = lc_contact_stop_rule(1000000, 1e-12, 0);
+    double *scratch = calloc((size_t)p->nb * 6, sizeof(double));
     lc_contact_solve s;
     int i;
     memcpy(gs, p->rows, (size_t)p->m * sizeof(lc_contact_row));
@@ -312,8 +313,9 @@ static int sweeps_from(const problem *p, const double *b, const double *lambda, 
         gs[i].lambda_n = lambda != NULL ? lambda[i] : 0.0;
     }
     memset(disp, 0, (size_t)p->nb * 3 * sizeof(double));
-    s = lc_contact_solver_run(gs, p->m, disp, p->inv_mass, p->inv_inertia, &stop);
+    s = lc_contact_solver_run(gs, p->m, p->nb, disp, p->inv_mass, p->inv_inertia, &stop, scratch);
     free(gs);
+    free(scratch);
     return s.residual <= 1e-12 ? s.sweeps : -1;
 }
 
