@@ -143,7 +143,7 @@ static int project_flow_points(lc_contact_projection *cp, lc_contact_island *c, 
     int pass, i, nt;
     if (f == NULL) return -1;
     t = f + nflow;
-    memcpy(f, flow, (size_t)nflow * sizeof(lc_touch));
+    if (nflow > 0) memcpy(f, flow, (size_t)nflow * sizeof(lc_touch));
     for (pass = 0; pass < LC_CONTACT_PROJECTION_PASSES; ++pass) {
         double left = 0.0;
         for (i = nt = 0; i < nflow; ++i)
