@@ -76,13 +76,10 @@ int lc_touch_refresh(const lc_world *w, const double *state, lc_touch *t, double
             least = k;
         }
     }
-    if (deepest < 0.0) {
-        /* inside b: the edge it is least deep behind, as the vertex-in-body test finds it */
-        t->edge = least;
-        touch_update(w, state, fa, fb, t);
-        return 1;
-    }
+    /* inside b: the edge it is least deep behind, as the vertex-in-body test finds it */
+    if (deepest < 0.0) t->edge = least;
     touch_update(w, state, fa, fb, t);
+    if (deepest < 0.0) return 1;
     /* outside b but behind its edge's line: beside the edge, not in it */
     if (t->gap < 0.0) return 0;
     /* as face_touches keeps a vertex: over the edge, the edge grown by extent for one within extent */
